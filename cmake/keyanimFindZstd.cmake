@@ -1,0 +1,17 @@
+# Normalises the zstd target name: upstream >= 1.5.6 exports zstd::libzstd, Debian 12 exports
+# only zstd::libzstd_shared/_static, older distributions ship just libzstd.pc.
+find_package(zstd CONFIG QUIET)
+if(TARGET zstd::libzstd)
+  set(KEYANIM_ZSTD_TARGET zstd::libzstd)
+elseif(TARGET zstd::libzstd_shared)
+  set(KEYANIM_ZSTD_TARGET zstd::libzstd_shared)
+elseif(TARGET zstd::libzstd_static)
+  set(KEYANIM_ZSTD_TARGET zstd::libzstd_static)
+else()
+  find_package(PkgConfig REQUIRED)
+  pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+  set(KEYANIM_ZSTD_TARGET PkgConfig::ZSTD)
+endif()
+if(NOT keyanim_FIND_QUIETLY)
+  message(STATUS "keyanim: using zstd target ${KEYANIM_ZSTD_TARGET}")
+endif()
