@@ -1,0 +1,56 @@
+// BVH reading and writing. The reader accepts the format as real files use it and reports
+// damage as file:line:column; the writer prints the shortest text that reads back bit-exactly.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "keyanim/offline/motion.h"
+
+namespace keyanim::offline {
+
+struct BvhError {
+  std::string file;      // as given by the caller
+  uint32_t line = 0;     // 1-based; 0 when the error is not about a place in the text
+  uint32_t column = 0;   // 1-based byte column
+  std::string message;   // "expected ..., found ..."
+  // "file:line:column: message"
+  std::string to_string() const;
+};
+
+struct BvhReadOptions {
+  uint32_t max_joints = 1u << 16;  // Defaults to 65536 nodes; more is an error, not an allocation.
+  uint32_t max_frames = 1u << 24;  // Defaults to 16777216 frames.
+};
+
+// Parses BVH text. On success fills `out` and appends any warnings (e.g. more motion lines than
+// `Frames:` declares: all lines are kept) to `warnings`. On failure returns false, fills `err` and
+// leaves `out` empty. What is accepted:
+//  - one or more ROOT blocks (a forest: every root has parent -1); JOINT; End Site, optionally
+//    followed by a name (kept in Joint::name); a joint without children or without CHANNELS;
+//  - OFFSET and CHANNELS (0..6 distinct channels in any order) before a block's children;
+//  - keywords in any case; LF, CRLF, lone CR, mixed; tabs, runs of spaces, blank lines, a UTF-8
+//    BOM; a '{' may end the ROOT/JOINT/End Site line;
+//  - joint names: the rest of the line after ROOT/JOINT, blanks trimmed at both ends;
+//  - numbers: std::from_chars forms plus a leading '+', fully consumed; nan/inf and overflow are
+//    errors; a value below the smallest subnormal reads as a signed zero (as strtod rounds it);
+//  - one frame per line (trailing blanks allowed). More lines than `Frames:` declares: all are
+//    kept, with a warning; fewer: an error naming both numbers. Nothing is allocated from the
+//    declared count beyond what the remaining text could hold.
+// Errors are "expected X, found Y" at the 1-based line and byte column of the offending token.
+bool read_bvh(std::string_view text, const std::string& file_name, Motion& out, BvhError& err,
+              std::vector<std::string>* warnings = nullptr, const BvhReadOptions& options = {});
+// Reads a whole file and parses it; I/O failures are reported with line 0.
+bool read_bvh_file(const std::string& path, Motion& out, BvhError& err,
+                   std::vector<std::string>* warnings = nullptr, const BvhReadOptions& options = {});
+
+// BVH text with LF line endings and tab indentation; numbers in std::to_chars' shortest form,
+// which reads back to the same double, so read(write(m)) == m bit for bit. Nodes are written
+// depth-first (children in index order: the reader's order) and the frame columns follow. A node
+// whose parent is not an earlier node is written as a ROOT; an End Site is written as "End Site"
+// (plus " name" if it has one) only when it has no channels and no children, else as a JOINT.
+// Writes min(frame_count, values.size() / channel_count) frames.
+std::string write_bvh(const Motion& motion);
+
+}  // namespace keyanim::offline
