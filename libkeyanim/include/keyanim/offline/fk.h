@@ -1,0 +1,54 @@
+// Forward kinematics: the ground truth for every error keyanim reports.
+//
+// Rules (spec/FORMAT.md states the same): a node's local rotation is the product of its Euler
+// channels in the order its CHANNELS line lists them (intrinsic), R = R_1 * R_2 * R_3, angles in
+// degrees. Its local translation is its OFFSET, except that each position channel it has
+// replaces the matching OFFSET component (as Blender reads BVH). World: p = p_parent +
+// R_parent_world * t_local, R_world = R_parent_world * R_local. A root (parent -1) starts from
+// the identity at the origin; an End Site has no channels, so its translation is its OFFSET.
+//
+// Elementary rotations are the right-handed ones: Rx(a) = [1 0 0; 0 c -s; 0 s c],
+// Ry(a) = [c 0 s; 0 1 0; -s 0 c], Rz(a) = [c -s 0; s c 0; 0 0 1].
+// Sine and cosine are computed after reducing the angle to the nearest multiple of 90 degrees,
+// so multiples of 90 are exact and an angle and the same angle +-360 give the same pose.
+//
+// Nodes must be stored parents first (parent < own index) and first_channel must be assigned
+// (Skeleton::assign_channel_columns); a node whose parent index is not smaller than its own is
+// treated as a root rather than read out of bounds.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "keyanim/offline/motion.h"
+
+namespace keyanim::offline {
+
+using Vec3 = std::array<double, 3>;
+using Mat3 = std::array<double, 9>;  // row-major
+
+// Rotation matrix of one joint from its channel values (frame row), Euler order as listed.
+Mat3 local_rotation(const Joint& joint, const double* frame_row);
+
+// World positions of every node (joints and End Sites) for one frame row of values.
+// `out` is resized to skeleton.joints.size(). Allocates nothing once `out` and a per-thread
+// scratch buffer have reached the skeleton's size.
+void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out);
+
+// World positions and world rotations (R_world of each node; an End Site's is its parent's).
+void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
+                std::vector<Mat3>& rotations);
+
+// World positions for every frame: result[f * node_count + j]. Frames that `values` is too
+// short to hold are filled with NaN.
+std::vector<Vec3> world_positions_all(const Motion& motion);
+
+// True when every node's channels lie inside a frame row (first_channel + channel count <=
+// channel_count()). FK of a skeleton for which this is false would read past the row.
+bool channel_columns_consistent(const Skeleton& skeleton) noexcept;
+
+// Largest side of the bounding box of the rest pose built from OFFSETs alone (End Sites
+// included). Tolerances given in percent are relative to this.
+double skeleton_size(const Skeleton& skeleton);
+
+}  // namespace keyanim::offline

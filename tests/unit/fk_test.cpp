@@ -1,0 +1,516 @@
+// Forward kinematics and error metrics against independent references: poses computed by hand,
+// a naive product of literal rotation matrices, and world positions exported by Blender's BVH
+// importer and by scipy (tests/data/fk/README.md says how those were made).
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "corpus_files.h"
+#include "keyanim/offline/bvh.h"
+#include "keyanim/offline/fk.h"
+#include "keyanim/offline/metrics.h"
+
+namespace {
+
+using keyanim::ChannelType;
+using keyanim::Joint;
+using keyanim::Skeleton;
+using keyanim::offline::Mat3;
+using keyanim::offline::Motion;
+using keyanim::offline::Vec3;
+
+constexpr ChannelType kXp = ChannelType::x_position;
+constexpr ChannelType kYp = ChannelType::y_position;
+constexpr ChannelType kZp = ChannelType::z_position;
+constexpr ChannelType kXr = ChannelType::x_rotation;
+constexpr ChannelType kYr = ChannelType::y_rotation;
+constexpr ChannelType kZr = ChannelType::z_rotation;
+
+Joint joint(const char* name, int32_t parent, Vec3 offset, std::vector<ChannelType> channels) {
+  Joint j;
+  j.name = name;
+  j.parent = parent;
+  j.offset = offset;
+  j.channels = std::move(channels);
+  return j;
+}
+
+Joint end_site(int32_t parent, Vec3 offset) {
+  Joint j;
+  j.parent = parent;
+  j.offset = offset;
+  j.end_site = true;
+  return j;
+}
+
+Skeleton skeleton_of(std::vector<Joint> joints) {
+  Skeleton s;
+  s.joints = std::move(joints);
+  s.assign_channel_columns();
+  return s;
+}
+
+std::vector<Vec3> fk(const Skeleton& s, const std::vector<double>& row) {
+  std::vector<Vec3> out;
+  keyanim::offline::world_positions(s, row.data(), out);
+  return out;
+}
+
+double distance(const Vec3& a, const Vec3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+void check_at(const Vec3& got, const Vec3& want, double tol = 1e-12) {
+  INFO("got (" << got[0] << ", " << got[1] << ", " << got[2] << "), want (" << want[0] << ", "
+               << want[1] << ", " << want[2] << ")");
+  CHECK(distance(got, want) <= tol);
+}
+
+// Literal right-handed elementary rotations and a naive product: a second implementation of
+// the Euler composition, sharing nothing with fk.cpp's column updates.
+Mat3 elementary(ChannelType axis, double degrees) {
+  const double a = degrees * std::numbers::pi / 180.0;
+  const double c = std::cos(a);
+  const double s = std::sin(a);
+  if (axis == kXr) return {1, 0, 0, 0, c, -s, 0, s, c};
+  if (axis == kYr) return {c, 0, s, 0, 1, 0, -s, 0, c};
+  return {c, -s, 0, s, c, 0, 0, 0, 1};
+}
+
+Mat3 multiply(const Mat3& a, const Mat3& b) {
+  Mat3 m{};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) m[r * 3 + c] += a[r * 3 + k] * b[k * 3 + c];
+  return m;
+}
+
+}  // namespace
+
+TEST_SUITE("fk") {
+
+// Chain used below: Hips (root) -> Knee at OFFSET (0,-4,0) -> End Site at OFFSET (0,0,2).
+// Rz(90) takes x->y, y->-x; Rx(90) takes y->z, z->-y; Ry(90) takes z->x, x->-z.
+TEST_CASE("fk hand-computed chain with position channels and ZYX order") {
+  const Skeleton s = skeleton_of({
+      joint("Hips", -1, {1, 2, 3}, {kXp, kYp, kZp, kZr, kYr, kXr}),
+      joint("Knee", 0, {0, -4, 0}, {kZr, kYr, kXr}),
+      end_site(1, {0, 0, 2}),
+  });
+  // Hips at (10,20,30) (the channels replace OFFSET (1,2,3)), Hips Z=90, Knee X=90.
+  const auto p = fk(s, {10, 20, 30, 90, 0, 0, 0, 0, 90});
+  REQUIRE(p.size() == 3);
+  check_at(p[0], {10, 20, 30});
+  // Knee = Hips + Rz90 (0,-4,0) = (10,20,30) + (4,0,0).
+  check_at(p[1], {14, 20, 30});
+  // End = Knee + Rz90 Rx90 (0,0,2) = Knee + Rz90 (0,-2,0) = Knee + (2,0,0).
+  check_at(p[2], {16, 20, 30});
+}
+
+TEST_CASE("fk hand-computed chain depends on the listed rotation order") {
+  // Root OFFSET (1,2,3) and no position channels; root angles Z=90, X=90 in two orders.
+  const Skeleton zxy = skeleton_of({
+      joint("Hips", -1, {1, 2, 3}, {kZr, kXr, kYr}),
+      joint("Knee", 0, {0, -4, 0}, {kZr, kXr, kYr}),
+      end_site(1, {0, 0, 2}),
+  });
+  // R = Rz90 Rx90. Knee = (1,2,3) + Rz90 Rx90 (0,-4,0) = (1,2,3) + Rz90 (0,0,-4) = (1,2,-1).
+  // End = Knee + Rz90 Rx90 (0,0,2) = Knee + Rz90 (0,-2,0) = Knee + (2,0,0) = (3,2,-1).
+  auto p = fk(zxy, {90, 90, 0, 0, 0, 0});
+  check_at(p[0], {1, 2, 3});
+  check_at(p[1], {1, 2, -1});
+  check_at(p[2], {3, 2, -1});
+
+  const Skeleton xzy = skeleton_of({
+      joint("Hips", -1, {1, 2, 3}, {kXr, kZr, kYr}),
+      joint("Knee", 0, {0, -4, 0}, {kZr, kXr, kYr}),
+      end_site(1, {0, 0, 2}),
+  });
+  // R = Rx90 Rz90. Knee = (1,2,3) + Rx90 (4,0,0) = (5,2,3).
+  // End = Knee + Rx90 Rz90 (0,0,2) = Knee + Rx90 (0,0,2) = Knee + (0,-2,0) = (5,0,3).
+  p = fk(xzy, {90, 90, 0, 0, 0, 0});
+  check_at(p[1], {5, 2, 3});
+  check_at(p[2], {5, 0, 3});
+}
+
+TEST_CASE("fk hand-computed Y and Z turns in both orders") {
+  // Root at the origin, joint B at OFFSET (1,0,0), End Site at OFFSET (0,2,0); Y=90 and Z=90.
+  const Skeleton yz = skeleton_of({
+      joint("A", -1, {0, 0, 0}, {kYr, kZr}),
+      joint("B", 0, {1, 0, 0}, {kZr}),
+      end_site(1, {0, 2, 0}),
+  });
+  // R = Ry90 Rz90: B = Ry90 (0,1,0) = (0,1,0); End = B + Ry90 (-2,0,0) = B + (0,0,2).
+  auto p = fk(yz, {90, 90, 0});
+  check_at(p[1], {0, 1, 0});
+  check_at(p[2], {0, 1, 2});
+  const Skeleton zy = skeleton_of({
+      joint("A", -1, {0, 0, 0}, {kZr, kYr}),
+      joint("B", 0, {1, 0, 0}, {kZr}),
+      end_site(1, {0, 2, 0}),
+  });
+  // R = Rz90 Ry90: B = Rz90 (0,0,-1) = (0,0,-1); End = B + Rz90 (0,2,0) = B + (-2,0,0).
+  p = fk(zy, {90, 90, 0});
+  check_at(p[1], {0, 0, -1});
+  check_at(p[2], {-2, 0, -1});
+  // B's own rotation turns its End Site but not B: B Z=90 with the root still Y=90, Z=90:
+  // End = B + Ry90 Rz90 Rz90 (0,2,0) = B + Ry90 (0,-2,0) = (0,1,0) + (0,-2,0).
+  p = fk(yz, {90, 90, 90});
+  check_at(p[1], {0, 1, 0});
+  check_at(p[2], {0, -1, 0});
+}
+
+TEST_CASE("fk non-right angle and partial position channels") {
+  const Skeleton s = skeleton_of({
+      joint("Root", -1, {0, 0, 0}, {kZr}),
+      joint("Slide", 0, {1, 2, 3}, {kYp}),  // Yposition replaces only OFFSET's y
+      joint("Arm", 0, {2, 0, 0}, {}),
+  });
+  // Z=30: Slide = Rz30 (1,7,3) = (cos30 - 7 sin30, sin30 + 7 cos30, 3); Arm = (2cos30, 2sin30, 0).
+  const double c = std::sqrt(3.0) / 2.0;
+  const auto p = fk(s, {30, 7});
+  check_at(p[1], {c - 3.5, 0.5 + 7 * c, 3}, 1e-14);
+  check_at(p[2], {2 * c, 1, 0}, 1e-14);
+}
+
+TEST_CASE("fk angles 360 degrees apart give identical positions") {
+  const Skeleton s = skeleton_of({
+      joint("Hips", -1, {0, 0, 0}, {kZr, kXr, kYr}),
+      joint("Knee", 0, {0, -4, 0}, {kZr, kXr, kYr}),
+      end_site(1, {0.5, 0, 2}),
+  });
+  const auto a = fk(s, {30.25, -17.5, 101.125, 12.5, 250.75, -3});
+  const auto b = fk(s, {390.25, 342.5, -258.875, -347.5, -109.25, 717});
+  for (size_t j = 0; j < a.size(); ++j) CHECK(a[j] == b[j]);
+}
+
+TEST_CASE("fk local rotation equals the product of literal elementary matrices") {
+  const std::array<std::array<ChannelType, 3>, 6> orders{{{kXr, kYr, kZr},
+                                                           {kXr, kZr, kYr},
+                                                           {kYr, kXr, kZr},
+                                                           {kYr, kZr, kXr},
+                                                           {kZr, kXr, kYr},
+                                                           {kZr, kYr, kXr}}};
+  const std::vector<double> row{5, 6, 7, 23.5, -71.25, 148.0};
+  for (const auto& order : orders) {
+    Joint j = joint("J", -1, {0, 0, 0}, {kXp, kYp, kZp, order[0], order[1], order[2]});
+    const Mat3 got = keyanim::offline::local_rotation(j, row.data());
+    const Mat3 want = multiply(multiply(elementary(order[0], row[3]), elementary(order[1], row[4])),
+                               elementary(order[2], row[5]));
+    for (size_t k = 0; k < 9; ++k) CHECK(got[k] == doctest::Approx(want[k]).epsilon(1e-13));
+  }
+}
+
+TEST_CASE("fk world pose rotations compose parent then local") {
+  const Skeleton s = skeleton_of({
+      joint("Hips", -1, {0, 0, 0}, {kXp, kYp, kZp, kYr, kXr, kZr}),
+      joint("Spine", 0, {0, 3, 0}, {kXr, kZr, kYr}),
+      end_site(1, {0, 1, 0}),
+  });
+  const std::vector<double> row{1, 2, 3, 10, 20, 30, -40, 50, -60};
+  std::vector<Vec3> pos;
+  std::vector<Mat3> rot;
+  keyanim::offline::world_pose(s, row.data(), pos, rot);
+  const Mat3 hips = multiply(multiply(elementary(kYr, 10), elementary(kXr, 20)), elementary(kZr, 30));
+  const Mat3 spine = multiply(
+      hips, multiply(multiply(elementary(kXr, -40), elementary(kZr, 50)), elementary(kYr, -60)));
+  for (size_t k = 0; k < 9; ++k) {
+    CHECK(rot[0][k] == doctest::Approx(hips[k]).epsilon(1e-13));
+    CHECK(rot[1][k] == doctest::Approx(spine[k]).epsilon(1e-13));
+    CHECK(rot[2][k] == rot[1][k]);  // an End Site has no rotation of its own
+  }
+  // Spine = (1,2,3) + hips (0,3,0); End = Spine + spine (0,1,0): the middle columns.
+  check_at(pos[1], {1 + 3 * hips[1], 2 + 3 * hips[4], 3 + 3 * hips[7]}, 1e-13);
+  check_at(pos[2], {pos[1][0] + spine[1], pos[1][1] + spine[4], pos[1][2] + spine[7]}, 1e-13);
+  // world_positions is the same computation.
+  const auto p = fk(s, row);
+  for (size_t j = 0; j < 3; ++j) CHECK(p[j] == pos[j]);
+}
+
+TEST_CASE("fk several roots each start at the origin") {
+  const Skeleton s = skeleton_of({
+      joint("A", -1, {1, 0, 0}, {kZr}),
+      end_site(0, {1, 0, 0}),
+      joint("B", -1, {0, 0, 5}, {kXr}),
+      end_site(2, {0, 1, 0}),
+  });
+  const auto p = fk(s, {90, 90});
+  check_at(p[0], {1, 0, 0});
+  check_at(p[1], {1, 1, 0});
+  check_at(p[2], {0, 0, 5});
+  check_at(p[3], {0, 0, 6});
+}
+
+TEST_CASE("fk a parent index not before its child is treated as a root") {
+  Skeleton s = skeleton_of({joint("A", -1, {1, 0, 0}, {}), joint("B", 5, {0, 2, 0}, {})});
+  const auto p = fk(s, {});
+  check_at(p[1], {0, 2, 0});
+  s.joints[1].parent = 1;  // itself
+  check_at(fk(s, {})[1], {0, 2, 0});
+}
+
+TEST_CASE("fk world_positions_all matches per-frame world_positions") {
+  Motion m;
+  m.skeleton = skeleton_of({
+      joint("Hips", -1, {0, 0, 0}, {kXp, kYp, kZp, kZr, kXr, kYr}),
+      joint("Knee", 0, {0, -4, 0}, {kZr, kXr, kYr}),
+      end_site(1, {0, 0, 2}),
+  });
+  m.frame_count = 3;
+  for (int f = 0; f < 3; ++f)
+    for (int c = 0; c < 9; ++c) m.values.push_back(0.5 * f + 7.25 * c - 11.0 * f * c);
+  const auto all = keyanim::offline::world_positions_all(m);
+  REQUIRE(all.size() == 9);
+  for (uint32_t f = 0; f < 3; ++f) {
+    std::vector<Vec3> one;
+    keyanim::offline::world_positions(m.skeleton, m.frame(f), one);
+    for (size_t j = 0; j < 3; ++j) CHECK(all[f * 3 + j] == one[j]);
+  }
+  // Too few values for the last frame: it is NaN, not read past the end.
+  m.values.resize(2 * 9 + 4);
+  const auto partial = keyanim::offline::world_positions_all(m);
+  REQUIRE(partial.size() == 9);
+  CHECK(partial[3] == all[3]);
+  CHECK(std::isnan(partial[6][0]));
+  // first_channel past the row: every frame NaN.
+  m.skeleton.joints[1].first_channel = 8;
+  CHECK_FALSE(keyanim::offline::channel_columns_consistent(m.skeleton));
+  CHECK(std::isnan(keyanim::offline::world_positions_all(m)[0][0]));
+}
+
+TEST_CASE("fk skeleton size is the largest side of the rest-pose box") {
+  // Rest positions: Root (100,0,0), Spine (100,10,0), End (103,10,0), Leg (98,-5,1),
+  // Foot End Site (98,-5,-7). Box sides x 5, y 15, z 8.
+  const Skeleton s = skeleton_of({
+      joint("Root", -1, {100, 0, 0}, {kXp, kYp, kZp, kZr, kYr, kXr}),
+      joint("Spine", 0, {0, 10, 0}, {kZr}),
+      end_site(1, {3, 0, 0}),
+      joint("Leg", 0, {-2, -5, 1}, {kZr}),
+      end_site(3, {0, 0, -8}),
+  });
+  CHECK(keyanim::offline::skeleton_size(s) == 15.0);
+  // An End Site can set the size: the foot 20 below the leg makes y span 10 - (-25) = 35.
+  Skeleton t = s;
+  t.joints[4].offset = {0, -20, 0};
+  CHECK(keyanim::offline::skeleton_size(t) == 35.0);
+  CHECK(keyanim::offline::skeleton_size(Skeleton{}) == 0.0);
+  CHECK(keyanim::offline::skeleton_size(skeleton_of({joint("A", -1, {4, 5, 6}, {})})) == 0.0);
+}
+
+TEST_CASE("fk matches Blender and scipy positions for corpus files") {
+  const std::filesystem::path corpus = keyanim::test::corpus_dir();
+  for (const std::string name : {"assimp__01_01", "bvh11__131_01", "makehuman__tpose"}) {
+    CAPTURE(name);
+    std::ifstream in(std::filesystem::path(KEYANIM_TEST_DATA_DIR) / "fk" / (name + ".json"));
+    REQUIRE(in.good());
+    const nlohmann::json ref = nlohmann::json::parse(in);
+    const std::filesystem::path bvh = corpus / ref.at("source").get<std::string>();
+    if (!std::filesystem::exists(bvh)) {
+      MESSAGE("corpus file absent, skipped: " << bvh.string());
+      continue;
+    }
+    Motion m;
+    keyanim::offline::BvhError err;
+    REQUIRE_MESSAGE(keyanim::offline::read_bvh_file(bvh.string(), m, err), err.to_string());
+
+    const auto& nodes = ref.at("nodes");
+    REQUIRE(nodes.size() == m.skeleton.joints.size());
+    for (size_t j = 0; j < nodes.size(); ++j) {
+      const Joint& joint = m.skeleton.joints[j];
+      CHECK(nodes[j].at("parent").get<int>() == joint.parent);
+      CHECK(nodes[j].at("end_site").get<bool>() == joint.end_site);
+      if (!joint.end_site) CHECK(nodes[j].at("name").get<std::string>() == joint.name);
+    }
+    const double size = keyanim::offline::skeleton_size(m.skeleton);
+    CHECK(size == doctest::Approx(ref.at("skeleton_size").get<double>()).epsilon(1e-10));
+
+    // Blender works in float32: it agrees with scipy to < 5e-7 of the size (README.md).
+    const double blender_tol = 1e-6 * size;
+    const double f64_tol = 1e-9 * size;
+    double worst_blender = 0.0;
+    double worst_f64 = 0.0;
+    const auto& frames = ref.at("frames");
+    for (size_t k = 0; k < frames.size(); ++k) {
+      const uint32_t f = frames[k].get<uint32_t>();
+      REQUIRE(f < m.frame_count);
+      std::vector<Vec3> got;
+      keyanim::offline::world_positions(m.skeleton, m.frame(f), got);
+      const auto& blender = ref.at("positions_blender")[k];
+      const auto& f64 = ref.at("positions_f64")[k];
+      REQUIRE(blender.size() == 3 * got.size());
+      REQUIRE(f64.size() == 3 * got.size());
+      for (size_t j = 0; j < got.size(); ++j) {
+        const Vec3 b{blender[3 * j].get<double>(), blender[3 * j + 1].get<double>(),
+                     blender[3 * j + 2].get<double>()};
+        const Vec3 s{f64[3 * j].get<double>(), f64[3 * j + 1].get<double>(),
+                     f64[3 * j + 2].get<double>()};
+        worst_blender = std::max(worst_blender, distance(got[j], b));
+        worst_f64 = std::max(worst_f64, distance(got[j], s));
+      }
+    }
+    MESSAGE(name << ": largest distance to Blender " << worst_blender / size
+                 << " of the skeleton size, to scipy " << worst_f64 / size);
+    CHECK(worst_blender <= blender_tol);
+    CHECK(worst_f64 <= f64_tol);
+  }
+}
+
+TEST_CASE("fk of every corpus file is unchanged by a BVH write and read") {
+  const auto files = keyanim::test::corpus_bvh_files();
+  if (files.empty()) MESSAGE("corpus absent, skipped");
+  for (const auto& path : files) {
+    const std::string file = path.string();
+    CAPTURE(file);
+    Motion a;
+    Motion b;
+    keyanim::offline::BvhError err;
+    REQUIRE_MESSAGE(keyanim::offline::read_bvh_file(file, a, err), err.to_string());
+    const std::string text = keyanim::offline::write_bvh(a);
+    REQUIRE_MESSAGE(keyanim::offline::read_bvh(text, "rewritten", b, err), err.to_string());
+    const auto pa = keyanim::offline::world_positions_all(a);
+    const auto pb = keyanim::offline::world_positions_all(b);
+    REQUIRE(pa.size() == pb.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < pa.size(); ++i) differing += pa[i] != pb[i] ? 1 : 0;
+    CHECK(differing == 0);
+  }
+}
+
+}  // TEST_SUITE
+
+TEST_SUITE("metrics") {
+
+namespace {
+
+// Hips (root, 6 channels, cols 0-5) with three children:
+//   Arm   at (0,5,0), ZXY cols 6-8, End Site 3 along x (a rotation about Arm's Z swings it);
+//   Head  at (0,2,0), ZXY cols 9-11, End Site of zero length (its rotation moves nothing);
+//   Tip   at (1,0,0), Yrotation col 12, no children (its rotation moves nothing).
+Motion metrics_motion() {
+  Motion m;
+  m.skeleton = skeleton_of({
+      joint("Hips", -1, {0, 0, 0}, {kXp, kYp, kZp, kZr, kXr, kYr}),
+      joint("Arm", 0, {0, 5, 0}, {kZr, kXr, kYr}),
+      end_site(1, {3, 0, 0}),
+      joint("Head", 0, {0, 2, 0}, {kZr, kXr, kYr}),
+      end_site(3, {0, 0, 0}),
+      joint("Tip", 0, {1, 0, 0}, {kYr}),
+  });
+  m.frame_count = 3;
+  m.frame_time = 1.0 / 30;
+  m.values.assign(3 * 13, 0.0);
+  return m;
+}
+
+void set(Motion& m, uint32_t f, uint32_t c, double v) { m.values[f * 13 + c] = v; }
+
+}  // namespace
+
+TEST_CASE("metrics identical motions have zero error") {
+  Motion a = metrics_motion();
+  set(a, 1, 7, 33.0);
+  const auto r = keyanim::offline::measure_error(a, a);
+  CHECK(r.max_error == 0.0);
+  CHECK(r.rms_error == 0.0);
+  CHECK(r.max_leaf_rotation == 0.0);
+  CHECK(r.joint_max == std::vector<double>(6, 0.0));
+  CHECK(r.channel_max == std::vector<double>(13, 0.0));
+}
+
+TEST_CASE("metrics hand-computed errors worst node and frame and channels") {
+  Motion original = metrics_motion();
+  Motion decoded = metrics_motion();
+  for (uint32_t f = 0; f < 3; ++f) {
+    set(original, f, 3, 170.0);  // Hips Z: 360 apart, the same pose and no channel error
+    set(decoded, f, 3, -190.0);
+  }
+  set(decoded, 0, 0, 0.25);   // frame 0: Hips x moves every node by 0.25
+  set(decoded, 1, 6, 10.0);   // frame 1: Arm Z 10 degrees: End Site chord 2*3*sin(5)
+  set(decoded, 2, 6, 4.0);    // frame 2: Arm Z 4 degrees: chord 2*3*sin(2)
+  set(decoded, 0, 10, 7.0);   // Head X: moves nothing (zero-length End Site)
+  set(original, 0, 12, 179.0);  // Tip Y: 179 vs -179 differ by 2 modulo 360
+  set(decoded, 0, 12, -179.0);
+
+  const double deg = std::numbers::pi / 180.0;
+  const double e1 = 2 * 3 * std::sin(5 * deg);
+  const double e2 = 2 * 3 * std::sin(2 * deg);
+  auto r = keyanim::offline::measure_error(original, decoded);
+  CHECK(r.max_error == doctest::Approx(e1).epsilon(1e-12));
+  CHECK(r.worst_joint == 2);
+  CHECK(r.worst_frame == 1);
+  const double rms = std::sqrt((6 * 0.25 * 0.25 + e1 * e1 + e2 * e2) / 18.0);
+  CHECK(r.rms_error == doctest::Approx(rms).epsilon(1e-12));
+  REQUIRE(r.joint_max.size() == 6);
+  for (size_t j : {0, 1, 3, 4, 5}) CHECK(r.joint_max[j] == doctest::Approx(0.25).epsilon(1e-12));
+  CHECK(r.joint_max[2] == doctest::Approx(e1).epsilon(1e-12));
+  REQUIRE(r.channel_max.size() == 13);
+  const std::vector<double> want{0.25, 0, 0, 0, 0, 0, 10, 0, 0, 0, 7, 0, 2};
+  for (size_t c = 0; c < 13; ++c) {
+    CAPTURE(c);
+    CHECK(r.channel_max[c] == doctest::Approx(want[c]).epsilon(1e-12));
+  }
+  // Head's 7 degrees count; Arm's 10 do not (its End Site has length).
+  CHECK(r.max_leaf_rotation == doctest::Approx(7.0).epsilon(1e-12));
+
+  // Tip (no children at all) counts too.
+  set(decoded, 2, 12, -12.5);
+  r = keyanim::offline::measure_error(original, decoded);
+  CHECK(r.channel_max[12] == doctest::Approx(12.5).epsilon(1e-12));
+  CHECK(r.max_leaf_rotation == doctest::Approx(12.5).epsilon(1e-12));
+  CHECK(r.max_error == doctest::Approx(e1).epsilon(1e-12));  // Tip's rotation moved nothing
+}
+
+TEST_CASE("metrics modulo 360 channel comparison") {
+  Motion a = metrics_motion();
+  Motion b = metrics_motion();
+  set(a, 0, 9, 359.0);    // Head Z: 359 vs -359 differ by 718 = 2*360 - 2
+  set(b, 0, 9, -359.0);
+  set(a, 1, 11, 540.0);   // Head Y: 540 vs 0 differ by 180 either way round
+  set(a, 2, 10, -360.0);  // Head X: -360 vs 0 is no difference
+  set(a, 2, 0, 540.0);    // Hips x is a length: no wrapping, 540
+  const auto r = keyanim::offline::measure_error(a, b);
+  CHECK(r.channel_max[9] == doctest::Approx(2.0).epsilon(1e-12));
+  CHECK(r.channel_max[11] == doctest::Approx(180.0).epsilon(1e-12));
+  CHECK(r.channel_max[10] == 0.0);
+  CHECK(r.channel_max[0] == 540.0);
+  CHECK(r.max_leaf_rotation == doctest::Approx(180.0).epsilon(1e-12));
+}
+
+TEST_CASE("metrics mismatched or broken motions report infinity") {
+  const double inf = std::numeric_limits<double>::infinity();
+  const Motion a = metrics_motion();
+  Motion fewer_frames = a;
+  fewer_frames.frame_count = 2;
+  fewer_frames.values.resize(2 * 13);
+  CHECK(keyanim::offline::measure_error(a, fewer_frames).max_error == inf);
+
+  Motion more_channels = a;
+  more_channels.skeleton.joints[5].channels.push_back(kXr);
+  more_channels.skeleton.assign_channel_columns();
+  more_channels.values.assign(3 * 14, 0.0);
+  const auto r = keyanim::offline::measure_error(a, more_channels);
+  CHECK(r.max_error == inf);
+  CHECK(r.rms_error == inf);
+
+  Motion short_values = a;
+  short_values.values.resize(20);
+  CHECK(keyanim::offline::measure_error(a, short_values).max_error == inf);
+
+  Motion nan = a;
+  set(nan, 1, 6, std::numeric_limits<double>::quiet_NaN());
+  const auto rn = keyanim::offline::measure_error(a, nan);
+  CHECK(rn.max_error == inf);
+  CHECK(rn.worst_frame == 1);
+  CHECK(rn.channel_max[6] == inf);
+}
+
+}  // TEST_SUITE
