@@ -1,0 +1,28 @@
+// Writing the .kanim container (spec/FORMAT.md). Reading is the runtime's job (keyanim/clip.h).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "keyanim/clip.h"
+#include "keyanim/offline/encode.h"
+
+namespace keyanim::offline {
+
+// Empty if `clip` can be written (it follows every rule of spec/FORMAT.md: key frames strictly
+// increasing and below frame_count, |q| <= 2^53, finite values, step > 0, tension in [-1, 1],
+// parents before children, End Sites without channels ...), else the first rule it breaks.
+std::string validate_encoded_clip(const EncodedClip& clip);
+
+// The complete file: signature, header, section table, sections, CRC-32. Each section is a
+// zstd frame at `zstd_level` (clamped to at most zstd's maximum) when that is smaller, else
+// stored raw; zstd_level <= 0 stores every section raw. Returns an empty vector if
+// validate_encoded_clip(clip) is not empty.
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level = 19);
+
+// The clip a decoder builds from write_kanim(clip), without the bytes: the encoder verifies
+// its error on this. Its arrays are identical to those Clip::load builds from the file.
+// `clip` must be valid (validate_encoded_clip).
+Clip to_clip(const EncodedClip& clip);
+
+}  // namespace keyanim::offline

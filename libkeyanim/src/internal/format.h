@@ -1,0 +1,53 @@
+// Constants of the .kanim container (spec/FORMAT.md), shared by the writer and the loader so
+// that the two can never disagree on a tag, a size or a flag bit.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+namespace keyanim::internal {
+
+inline constexpr uint8_t kSignature[8] = {0x89, 'K', 'A', 'N', 0x0D, 0x0A, 0x1A, 0x0A};
+inline constexpr size_t kSignatureSize = 8;
+inline constexpr size_t kHeaderEnd = 24;       // signature + 16-byte header
+inline constexpr size_t kTableEntrySize = 24;  // tag, flags, stored size, raw size
+inline constexpr size_t kChecksumSize = 4;
+
+// Header_Flags: bits 0-15 reserved (reject), bits 16-31 unused (ignore).
+inline constexpr uint32_t kHeaderReservedMask = 0x0000FFFFu;
+// Section_Flags.
+inline constexpr uint32_t kSectionCompressed = 1u << 0;
+inline constexpr uint32_t kSectionAncillary = 1u << 1;
+inline constexpr uint32_t kSectionReservedMask = 0x0000FFFCu;  // bits 2-15; 16-31 unused
+
+// A tag is four bytes in file order, read as a little-endian u32.
+constexpr uint32_t make_tag(char a, char b, char c, char d) noexcept {
+  return uint32_t(uint8_t(a)) | uint32_t(uint8_t(b)) << 8 | uint32_t(uint8_t(c)) << 16 |
+         uint32_t(uint8_t(d)) << 24;
+}
+inline constexpr uint32_t kTagClip = make_tag('C', 'L', 'I', 'P');
+inline constexpr uint32_t kTagSkel = make_tag('S', 'K', 'E', 'L');
+inline constexpr uint32_t kTagChan = make_tag('C', 'H', 'A', 'N');
+inline constexpr uint32_t kTagKtim = make_tag('K', 'T', 'I', 'M');
+inline constexpr uint32_t kTagKval = make_tag('K', 'V', 'A', 'L');
+inline constexpr uint32_t kTagNote = make_tag('N', 'O', 'T', 'E');
+// The critical sections, in the order a file must list them.
+inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTagKtim, kTagKval};
+
+inline constexpr size_t kClipSize = 32;
+inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count
+inline constexpr size_t kChanBytesPerChannel = 17;  // u8 + f32 + f64 + u32
+inline constexpr uint8_t kNodeEndSite = 1u << 0;
+inline constexpr uint8_t kNodeReservedMask = 0xFEu;
+inline constexpr uint32_t kMaxNodeChannels = 6;
+inline constexpr uint8_t kMaxChannelType = 5;
+inline constexpr uint8_t kMaxTangentRule = 1;
+inline constexpr uint8_t kMaxInterpolation = 1;
+
+inline constexpr int64_t kMaxAbsQ = int64_t(1) << 53;      // |q| bound
+inline constexpr uint64_t kMaxAbsDelta = uint64_t(1) << 54;  // |q_i - q_{i-1}| bound
+inline constexpr uint32_t kMaxVarint32Bytes = 5;
+inline constexpr uint32_t kMaxVarint64Bytes = 10;
+
+inline constexpr uint32_t kZstdMagic = 0xFD2FB528u;
+
+}  // namespace keyanim::internal

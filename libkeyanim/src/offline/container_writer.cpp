@@ -1,0 +1,248 @@
+// Writes the .kanim container (spec/FORMAT.md) and builds the runtime Clip a decoder would
+// load from it.
+#include <zlib.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "internal/byte_writer.h"
+#include "internal/format.h"
+#include "internal/varint.h"
+#include "keyanim/offline/container.h"
+#include "keyanim/version.h"
+
+namespace keyanim::offline {
+namespace {
+
+using internal::put_bytes;
+using internal::put_le;
+using internal::put_varint;
+
+std::string channel_problem(const EncodedChannel& ch, uint32_t frame_count) {
+  if (static_cast<uint8_t>(ch.interp) > internal::kMaxInterpolation) return "unknown interpolation";
+  if (!std::isfinite(ch.tension) || ch.tension < -1.0f || ch.tension > 1.0f)
+    return "tension outside [-1, 1]";
+  if (!std::isfinite(ch.step) || !(ch.step > 0.0)) return "step not finite and > 0";
+  if (ch.frames.size() != ch.q.size()) return "frames and q differ in length";
+  if (ch.frames.size() > frame_count) return "more keys than frames";
+  for (size_t i = 0; i < ch.frames.size(); ++i) {
+    if (ch.frames[i] >= frame_count) return "key frame " + std::to_string(ch.frames[i]) + " >= frame_count";
+    if (i > 0 && ch.frames[i] <= ch.frames[i - 1]) return "key frames not strictly increasing";
+    if (ch.q[i] > internal::kMaxAbsQ || ch.q[i] < -internal::kMaxAbsQ) return "|q| > 2^53";
+    if (!std::isfinite(dequantize(ch.q[i], ch.step))) return "key value not finite in binary32";
+  }
+  return {};
+}
+
+std::vector<uint8_t> clip_section(const EncodedClip& clip, uint64_t keys) {
+  std::vector<uint8_t> s;
+  put_le<uint32_t>(s, clip.frame_count);
+  put_le<uint32_t>(s, static_cast<uint32_t>(clip.skeleton.joints.size()));
+  put_le<uint32_t>(s, static_cast<uint32_t>(clip.channels.size()));
+  put_le<uint8_t>(s, static_cast<uint8_t>(clip.tangent_rule));
+  put_le<uint8_t>(s, 0);   // Clip_Flags
+  put_le<uint16_t>(s, 0);  // Clip_Reserved
+  put_le<double>(s, clip.frame_time);
+  put_le<uint64_t>(s, keys);
+  return s;
+}
+
+std::vector<uint8_t> skel_section(const Skeleton& skel) {
+  std::vector<uint8_t> s;
+  for (const Joint& j : skel.joints) {
+    put_le<uint32_t>(s, static_cast<uint32_t>(j.name.size()));
+    put_bytes(s, j.name.data(), j.name.size());
+    put_le<int32_t>(s, j.parent);
+    for (double o : j.offset) put_le<double>(s, o);
+    put_le<uint8_t>(s, j.end_site ? internal::kNodeEndSite : 0);
+    put_le<uint8_t>(s, static_cast<uint8_t>(j.channels.size()));
+    for (ChannelType t : j.channels) put_le<uint8_t>(s, static_cast<uint8_t>(t));
+  }
+  return s;
+}
+
+// Column by column: values of one kind sit together and compress better.
+std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans) {
+  std::vector<uint8_t> s;
+  s.reserve(chans.size() * internal::kChanBytesPerChannel);
+  for (const auto& c : chans) put_le<uint8_t>(s, static_cast<uint8_t>(c.interp));
+  for (const auto& c : chans) put_le<float>(s, c.tension);
+  for (const auto& c : chans) put_le<double>(s, c.step);
+  for (const auto& c : chans) put_le<uint32_t>(s, static_cast<uint32_t>(c.frames.size()));
+  return s;
+}
+
+std::vector<uint8_t> ktim_section(const std::vector<EncodedChannel>& chans) {
+  std::vector<uint8_t> s;
+  for (const auto& c : chans) {
+    for (size_t i = 0; i < c.frames.size(); ++i)
+      put_varint(s, i == 0 ? c.frames[0] : uint64_t(c.frames[i] - c.frames[i - 1] - 1));
+  }
+  return s;
+}
+
+std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans) {
+  std::vector<uint8_t> s;
+  for (const auto& c : chans) {
+    int64_t prev = 0;
+    for (int64_t q : c.q) {
+      put_varint(s, internal::zigzag_encode(q - prev));  // |q| <= 2^53: no overflow
+      prev = q;
+    }
+  }
+  return s;
+}
+
+struct Section {
+  uint32_t tag = 0;
+  uint32_t flags = 0;
+  uint64_t raw_size = 0;
+  std::vector<uint8_t> stored;
+};
+
+Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, int level) {
+  Section sec;
+  sec.tag = tag;
+  sec.flags = flags;
+  sec.raw_size = raw.size();
+  if (!raw.empty() && cctx != nullptr) {
+    std::vector<uint8_t> z(ZSTD_compressBound(raw.size()));
+    ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);  // the spec requires it
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);     // the file has its own CRC
+    const size_t n = ZSTD_compress2(cctx, z.data(), z.size(), raw.data(), raw.size());
+    if (!ZSTD_isError(n) && n < raw.size()) {
+      z.resize(n);
+      sec.stored = std::move(z);
+      sec.flags |= internal::kSectionCompressed;
+      return sec;
+    }
+  }
+  sec.stored = std::move(raw);
+  return sec;
+}
+
+uint32_t crc32_of(const uint8_t* p, size_t n) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  while (n > 0) {  // zlib takes uInt lengths
+    const uInt chunk = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
+    crc = crc32(crc, p, chunk);
+    p += chunk;
+    n -= chunk;
+  }
+  return static_cast<uint32_t>(crc);
+}
+
+}  // namespace
+
+std::string validate_encoded_clip(const EncodedClip& clip) {
+  const auto& joints = clip.skeleton.joints;
+  if (joints.size() > UINT32_MAX) return "too many nodes";
+  uint64_t channel_sum = 0;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const Joint& j = joints[i];
+    const std::string where = "node " + std::to_string(i) + ": ";
+    if (j.name.size() > UINT32_MAX) return where + "name too long";
+    if (j.parent < -1 || (j.parent >= 0 && static_cast<size_t>(j.parent) >= i))
+      return where + "parent must be -1 or an earlier node";
+    if (j.parent >= 0 && joints[static_cast<size_t>(j.parent)].end_site)
+      return where + "parent is an End Site";
+    if (j.end_site && j.parent < 0) return where + "End Site without a parent";
+    if (j.end_site && !j.channels.empty()) return where + "End Site with channels";
+    if (j.channels.size() > internal::kMaxNodeChannels) return where + "more than 6 channels";
+    for (ChannelType t : j.channels)
+      if (static_cast<uint8_t>(t) > internal::kMaxChannelType) return where + "unknown channel type";
+    for (double o : j.offset)
+      if (!std::isfinite(o)) return where + "offset not finite";
+    channel_sum += j.channels.size();
+  }
+  if (channel_sum != clip.channels.size()) return "channel count differs from the skeleton's";
+  if (static_cast<uint8_t>(clip.tangent_rule) > internal::kMaxTangentRule) return "unknown tangent rule";
+  if (!std::isfinite(clip.frame_time) || clip.frame_time < 0.0 ||
+      (clip.frame_count > 1 && !(clip.frame_time > 0.0)))
+    return "frame_time must be finite, >= 0, and > 0 when there are several frames";
+  uint64_t keys = 0;
+  for (size_t c = 0; c < clip.channels.size(); ++c) {
+    const std::string p = channel_problem(clip.channels[c], clip.frame_count);
+    if (!p.empty()) return "channel " + std::to_string(c) + ": " + p;
+    keys += clip.channels[c].frames.size();
+  }
+  if (keys > UINT32_MAX) return "more than 2^32 - 1 keys";
+  return {};
+}
+
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
+  if (!validate_encoded_clip(clip).empty()) return {};
+  uint64_t keys = 0;
+  for (const auto& c : clip.channels) keys += c.frames.size();
+
+  const int level = std::min(zstd_level, ZSTD_maxCLevel());
+  // Null (level <= 0, or out of memory): every section is stored raw, still a valid file.
+  ZSTD_CCtx* cctx = level > 0 ? ZSTD_createCCtx() : nullptr;
+  std::vector<Section> sections;
+  sections.push_back(make_section(internal::kTagClip, 0, clip_section(clip, keys), nullptr, level));
+  sections.push_back(make_section(internal::kTagSkel, 0, skel_section(clip.skeleton), cctx, level));
+  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels), cctx, level));
+  sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
+  sections.push_back(make_section(internal::kTagKval, 0, kval_section(clip.channels), cctx, level));
+  if (!clip.notes.empty()) {
+    std::vector<uint8_t> text(clip.notes.begin(), clip.notes.end());
+    sections.push_back(make_section(internal::kTagNote, internal::kSectionAncillary, std::move(text), cctx, level));
+  }
+  ZSTD_freeCCtx(cctx);
+
+  std::vector<uint8_t> out;
+  size_t total = internal::kHeaderEnd + internal::kTableEntrySize * sections.size() + internal::kChecksumSize;
+  for (const auto& s : sections) total += s.stored.size();
+  out.reserve(total);
+  put_bytes(out, internal::kSignature, internal::kSignatureSize);
+  put_le<uint16_t>(out, kFormatVersionMajor);
+  put_le<uint16_t>(out, kFormatVersionMinor);
+  put_le<uint32_t>(out, 0);  // Header_Flags
+  put_le<uint32_t>(out, static_cast<uint32_t>(sections.size()));
+  put_le<uint32_t>(out, 0);  // Header_Reserved
+  for (const auto& s : sections) {
+    put_le<uint32_t>(out, s.tag);
+    put_le<uint32_t>(out, s.flags);
+    put_le<uint64_t>(out, s.stored.size());
+    put_le<uint64_t>(out, s.raw_size);
+  }
+  for (const auto& s : sections) put_bytes(out, s.stored.data(), s.stored.size());
+  put_le<uint32_t>(out, crc32_of(out.data(), out.size()));
+  return out;
+}
+
+Clip to_clip(const EncodedClip& clip) {
+  Clip::Parts p;
+  p.version_major = kFormatVersionMajor;
+  p.version_minor = kFormatVersionMinor;
+  p.frame_count = clip.frame_count;
+  p.frame_time = clip.frame_time;
+  p.rule = clip.tangent_rule;
+  p.skeleton = clip.skeleton;
+  p.skeleton.assign_channel_columns();
+  size_t keys = 0;
+  for (const auto& c : clip.channels) keys += c.frames.size();
+  p.tracks.reserve(clip.channels.size());
+  p.key_frames.reserve(keys);
+  p.key_values.reserve(keys);
+  for (const auto& c : clip.channels) {
+    ChannelTrack t;
+    t.first_key = static_cast<uint32_t>(p.key_frames.size());
+    t.key_count = static_cast<uint32_t>(c.frames.size());
+    t.interp = c.interp;
+    t.s = tension_to_s(c.tension);
+    p.tracks.push_back(t);
+    p.key_frames.insert(p.key_frames.end(), c.frames.begin(), c.frames.end());
+    for (int64_t q : c.q) p.key_values.push_back(dequantize(q, c.step));
+  }
+  p.notes = clip.notes;
+  return Clip::from_parts(std::move(p));
+}
+
+}  // namespace keyanim::offline

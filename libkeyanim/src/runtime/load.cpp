@@ -1,0 +1,531 @@
+// Loading a .kanim file: every rule of spec/FORMAT.md is checked once, here, in the order of
+// its section 7, before anything a file declares is allocated; the sampler then trusts the
+// arrays.
+#include <zlib.h>
+#include <zstd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <new>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "internal/byte_reader.h"
+#include "internal/format.h"
+#include "internal/varint.h"
+#include "keyanim/clip.h"
+
+namespace keyanim {
+namespace {
+
+using internal::ByteReader;
+
+std::string tag_name(uint32_t tag) {
+  std::string s(4, '?');
+  for (int i = 0; i < 4; ++i) {
+    const char ch = static_cast<char>((tag >> (8 * i)) & 0xFF);
+    s[static_cast<size_t>(i)] = (ch >= 0x20 && ch < 0x7F) ? ch : '?';
+  }
+  return s;
+}
+
+struct TableEntry {
+  uint32_t tag = 0;
+  uint32_t flags = 0;
+  uint64_t stored = 0;
+  uint64_t raw = 0;
+  uint64_t file_offset = 0;   // where the stored bytes start
+  uint64_t entry_offset = 0;  // where the table entry starts
+};
+
+// A section's raw content and how to turn an offset in it into an offset in the file.
+struct Content {
+  const uint8_t* data = nullptr;
+  size_t size = 0;
+  uint64_t file_offset = 0;
+  bool compressed = false;
+  const char* name = "";
+};
+
+struct DctxDeleter {
+  void operator()(ZSTD_DCtx* d) const noexcept { ZSTD_freeDCtx(d); }
+};
+
+class Loader {
+ public:
+  Loader(std::span<const uint8_t> bytes, const DecodeLimits& limits, ErrorInfo* err)
+      : bytes_(bytes), limits_(limits), err_(err) {}
+
+  Status run(Clip::Parts& parts);
+
+ private:
+  Status fail(Status s, const char* section, uint64_t offset, std::string detail) {
+    if (err_ != nullptr) {
+      err_->status = s;
+      err_->section = section;
+      err_->byte_offset = offset;
+      err_->detail = std::move(detail);
+    }
+    return s;
+  }
+  // Failure at offset `at` of a section's content.
+  Status fail_in(Status s, const Content& c, size_t at, std::string detail) {
+    if (c.compressed)
+      return fail(s, c.name, c.file_offset,
+                  detail + " (at byte " + std::to_string(at) + " of the decompressed section)");
+    return fail(s, c.name, c.file_offset + at, std::move(detail));
+  }
+
+  Status read_header_and_table();
+  Status get_content(const TableEntry& e, const char* name, Content& out);
+  Status parse_clip(const Content& c, Clip::Parts& parts);
+  Status parse_skel(const Content& c, Clip::Parts& parts);
+  Status parse_chan(const Content& c, Clip::Parts& parts);
+  Status parse_ktim(const Content& c, Clip::Parts& parts);
+  Status parse_kval(const Content& c, Clip::Parts& parts);
+
+  std::span<const uint8_t> bytes_;
+  const DecodeLimits& limits_;
+  ErrorInfo* err_;
+
+  uint16_t minor_ = 0;
+  std::vector<TableEntry> table_;
+  int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL
+  int note_index_ = -1;
+  std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx_;
+  std::vector<std::vector<uint8_t>> buffers_;  // decompressed sections, alive until parsed
+
+  // From CLIP.
+  uint64_t key_count_ = 0;
+  uint32_t node_count_ = 0;
+  uint32_t channel_count_ = 0;
+  // From CHAN, needed by KVAL.
+  std::vector<double> steps_;
+};
+
+Status Loader::read_header_and_table() {
+  const uint8_t* p = bytes_.data();
+  const size_t size = bytes_.size();
+  for (size_t i = 0; i < internal::kSignatureSize; ++i) {
+    if (i >= size) return fail(Status::truncated, "signature", size, "the file ends inside the signature");
+    if (p[i] != internal::kSignature[i])
+      return fail(Status::bad_signature, "signature", i, "not a .kanim file (signature mismatch)");
+  }
+  if (size < internal::kHeaderEnd) return fail(Status::truncated, "header", size, "the file ends inside the header");
+  ByteReader r(p, size);
+  r.skip(internal::kSignatureSize);
+  uint16_t major = 0;
+  uint32_t header_flags = 0, section_count = 0, reserved = 0;
+  r.read(major);
+  r.read(minor_);
+  r.read(header_flags);
+  r.read(section_count);
+  r.read(reserved);
+  if (major != 1)
+    return fail(Status::unsupported_version, "header", 8,
+                "major version " + std::to_string(major) + " (this decoder reads version 1)");
+  if (header_flags & internal::kHeaderReservedMask)
+    return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
+  if (reserved != 0) return fail(Status::reserved_bits_set, "header", 20, "Header_Reserved is not 0");
+
+  // The table and the checksum must fit: 24 * count + 4 <= size - 24, in subtraction form.
+  const size_t avail = size - internal::kHeaderEnd;
+  if (avail < internal::kChecksumSize ||
+      section_count > (avail - internal::kChecksumSize) / internal::kTableEntrySize)
+    return fail(Status::truncated, "table", size,
+                "the file ends inside the section table of " + std::to_string(section_count) + " entries");
+  table_.resize(section_count);  // bounded by the file size just checked
+  uint64_t pos = internal::kHeaderEnd + uint64_t(section_count) * internal::kTableEntrySize;
+  size_t next_critical = 0;
+  for (uint32_t i = 0; i < section_count; ++i) {
+    TableEntry& e = table_[i];
+    e.entry_offset = internal::kHeaderEnd + uint64_t(i) * internal::kTableEntrySize;
+    r.read(e.tag);
+    r.read(e.flags);
+    r.read(e.stored);
+    r.read(e.raw);
+    e.file_offset = pos;
+    const std::string name = "section " + std::to_string(i) + " (" + tag_name(e.tag) + ")";
+    if (e.flags & internal::kSectionReservedMask)
+      return fail(Status::reserved_bits_set, "table", e.entry_offset + 4, name + ": reserved Section_Flags bits are set");
+    const bool ancillary = (e.flags & internal::kSectionAncillary) != 0;
+    size_t crit = 5;
+    for (size_t k = 0; k < 5; ++k)
+      if (internal::kCriticalTags[k] == e.tag) crit = k;
+    if (crit < 5) {
+      if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
+      if (crit != next_critical)
+        return fail(Status::corrupt, "table", e.entry_offset,
+                    name + ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order");
+      critical_index_[crit] = static_cast<int>(i);
+      ++next_critical;
+    } else if (e.tag == internal::kTagNote) {
+      if (!ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": NOTE must be ancillary");
+      if (note_index_ >= 0) return fail(Status::corrupt, "table", e.entry_offset, name + ": a second NOTE section");
+      note_index_ = static_cast<int>(i);
+    } else if (!ancillary) {
+      return fail(Status::reserved_bits_set, "table", e.entry_offset,
+                  name + ": unknown critical section (this decoder does not know the tag)");
+    }
+    if (!(e.flags & internal::kSectionCompressed) && e.stored != e.raw)
+      return fail(Status::corrupt, "table", e.entry_offset + 8, name + ": uncompressed, but Stored_Size != Raw_Size");
+    if (e.stored > size - pos)
+      return fail(Status::truncated, "table", size, name + ": the file ends before the section's declared end");
+    pos += e.stored;
+  }
+  if (next_critical != 5)
+    return fail(Status::corrupt, "table", internal::kHeaderEnd,
+                std::string("missing critical section ") + tag_name(internal::kCriticalTags[next_critical]));
+  if (size - pos < internal::kChecksumSize) return fail(Status::truncated, "checksum", size, "the file ends inside the checksum");
+  if (size - pos > internal::kChecksumSize)
+    return fail(Status::trailing_bytes, "checksum", pos + internal::kChecksumSize,
+                std::to_string(size - pos - internal::kChecksumSize) + " bytes after the checksum");
+
+  // Everything this decoder will decompress or copy, before anything is.
+  uint64_t raw_total = 0;
+  for (uint32_t i = 0; i < section_count; ++i) {
+    const TableEntry& e = table_[i];
+    const bool known = e.tag == internal::kTagNote || !(e.flags & internal::kSectionAncillary);
+    if (!known) continue;
+    if (e.raw > limits_.max_decompressed_bytes - raw_total || e.raw > limits_.max_decompressed_bytes)
+      return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
+                  "decompressed sections exceed the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
+    raw_total += e.raw;
+  }
+
+  uLong crc = crc32(0L, Z_NULL, 0);
+  for (uint64_t done = 0; done < pos;) {
+    const uInt chunk = static_cast<uInt>(std::min<uint64_t>(pos - done, 1u << 30));
+    crc = crc32(crc, p + done, chunk);
+    done += chunk;
+  }
+  const uint32_t stored_crc = internal::load_le<uint32_t>(p + pos);
+  if (static_cast<uint32_t>(crc) != stored_crc)
+    return fail(Status::checksum_mismatch, "checksum", pos, "CRC-32 of the file does not match its checksum");
+  return Status::ok;
+}
+
+Status Loader::get_content(const TableEntry& e, const char* name, Content& out) {
+  out.name = name;
+  out.file_offset = e.file_offset;
+  const uint8_t* src = bytes_.data() + e.file_offset;
+  const size_t stored = static_cast<size_t>(e.stored);  // <= file size
+  if (!(e.flags & internal::kSectionCompressed)) {
+    out.data = src;
+    out.size = stored;
+    return Status::ok;
+  }
+  out.compressed = true;
+  if (stored < 4 || internal::load_le<uint32_t>(src) != internal::kZstdMagic)
+    return fail(Status::zstd_error, name, e.file_offset, "not a zstd frame");
+  const unsigned long long declared = ZSTD_getFrameContentSize(src, stored);
+  if (declared == ZSTD_CONTENTSIZE_ERROR) return fail(Status::zstd_error, name, e.file_offset, "bad zstd frame header");
+  if (declared == ZSTD_CONTENTSIZE_UNKNOWN)
+    return fail(Status::zstd_error, name, e.file_offset, "the zstd frame does not declare its content size");
+  if (declared != e.raw)
+    return fail(Status::zstd_error, name, e.file_offset,
+                "the zstd frame declares " + std::to_string(declared) + " bytes, Raw_Size is " + std::to_string(e.raw));
+  const size_t frame = ZSTD_findFrameCompressedSize(src, stored);
+  if (ZSTD_isError(frame) || frame != stored)
+    return fail(Status::zstd_error, name, e.file_offset, "Stored_Size is not exactly one zstd frame");
+  if (e.raw > std::numeric_limits<size_t>::max())
+    return fail(Status::limit_exceeded, name, e.file_offset, "section too large for this platform");
+  if (!dctx_) {
+    dctx_.reset(ZSTD_createDCtx());
+    if (!dctx_) return fail(Status::zstd_error, name, e.file_offset, "cannot create a zstd context");
+  }
+  buffers_.emplace_back(static_cast<size_t>(e.raw) + 1);  // +1: a valid pointer when raw is 0
+  std::vector<uint8_t>& buf = buffers_.back();
+  const size_t got = ZSTD_decompressDCtx(dctx_.get(), buf.data(), static_cast<size_t>(e.raw), src, stored);
+  if (ZSTD_isError(got))
+    return fail(Status::zstd_error, name, e.file_offset, std::string("zstd: ") + ZSTD_getErrorName(got));
+  if (got != e.raw) return fail(Status::zstd_error, name, e.file_offset, "the zstd frame decompressed to the wrong size");
+  out.data = buf.data();
+  out.size = got;
+  return Status::ok;
+}
+
+Status Loader::parse_clip(const Content& c, Clip::Parts& parts) {
+  if (c.size != internal::kClipSize)
+    return fail_in(Status::corrupt, c, 0, "CLIP must be 32 bytes, not " + std::to_string(c.size));
+  ByteReader r(c.data, c.size);
+  uint32_t frames = 0;
+  uint8_t rule = 0, flags = 0;
+  uint16_t reserved = 0;
+  double frame_time = 0;
+  r.read(frames);
+  r.read(node_count_);
+  r.read(channel_count_);
+  r.read(rule);
+  r.read(flags);
+  r.read(reserved);
+  r.read(frame_time);
+  r.read(key_count_);
+  if (frames > limits_.max_frames)
+    return fail_in(Status::limit_exceeded, c, 0, "Frame_Count " + std::to_string(frames) + " exceeds the limit");
+  if (node_count_ > limits_.max_joints)
+    return fail_in(Status::limit_exceeded, c, 4, "Node_Count " + std::to_string(node_count_) + " exceeds the limit");
+  if (channel_count_ > limits_.max_channels)
+    return fail_in(Status::limit_exceeded, c, 8, "Channel_Count " + std::to_string(channel_count_) + " exceeds the limit");
+  if (rule > internal::kMaxTangentRule)
+    return fail_in(Status::reserved_bits_set, c, 12, "reserved Tangent_Rule " + std::to_string(rule));
+  if (flags != 0) return fail_in(Status::reserved_bits_set, c, 13, "reserved Clip_Flags bits are set");
+  if (reserved != 0) return fail_in(Status::reserved_bits_set, c, 14, "Clip_Reserved is not 0");
+  if (!std::isfinite(frame_time) || frame_time < 0.0 || (frames > 1 && !(frame_time > 0.0)))
+    return fail_in(Status::corrupt, c, 16, "Frame_Time must be finite, >= 0, and > 0 when Frame_Count > 1");
+  if (key_count_ > limits_.max_keys)
+    return fail_in(Status::limit_exceeded, c, 24, "Key_Count " + std::to_string(key_count_) + " exceeds the limit");
+  if (key_count_ > UINT32_MAX)
+    return fail_in(Status::limit_exceeded, c, 24, "this decoder holds fewer than 2^32 keys");
+  if (key_count_ > uint64_t(channel_count_) * frames)
+    return fail_in(Status::corrupt, c, 24, "Key_Count exceeds Channel_Count x Frame_Count");
+  parts.frame_count = frames;
+  parts.frame_time = frame_time;
+  parts.rule = static_cast<TangentRule>(rule);
+  return Status::ok;
+}
+
+Status Loader::parse_skel(const Content& c, Clip::Parts& parts) {
+  if (node_count_ > c.size / internal::kNodeFixedBytes)
+    return fail_in(Status::corrupt, c, 0,
+                   "SKEL is too short for " + std::to_string(node_count_) + " nodes");
+  auto& joints = parts.skeleton.joints;
+  joints.resize(node_count_);
+  ByteReader r(c.data, c.size);
+  uint64_t channel_sum = 0;
+  for (uint32_t i = 0; i < node_count_; ++i) {
+    Joint& j = joints[i];
+    const std::string node = "node " + std::to_string(i) + ": ";
+    const size_t start = r.pos();
+    uint32_t name_len = 0;
+    const uint8_t* name = nullptr;
+    if (!r.read(name_len) || !r.bytes(name_len, name))
+      return fail_in(Status::corrupt, c, start, node + "the name runs past the end of SKEL");
+    j.name.assign(reinterpret_cast<const char*>(name), name_len);
+    const size_t fixed = r.pos();
+    if (r.remaining() < internal::kNodeFixedBytes - 4)
+      return fail_in(Status::corrupt, c, fixed, node + "the record runs past the end of SKEL");
+    uint8_t flags = 0, count = 0;
+    r.read(j.parent);
+    for (double& o : j.offset) r.read(o);
+    r.read(flags);
+    r.read(count);
+    if (j.parent < -1 || (j.parent >= 0 && static_cast<uint32_t>(j.parent) >= i))
+      return fail_in(Status::corrupt, c, fixed, node + "Parent must be -1 or an earlier node");
+    if (j.parent >= 0 && joints[static_cast<size_t>(j.parent)].end_site)
+      return fail_in(Status::corrupt, c, fixed, node + "the parent is an End Site");
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(j.offset[static_cast<size_t>(k)]))
+        return fail_in(Status::corrupt, c, fixed + 4 + 8 * static_cast<size_t>(k), node + "Offset is not finite");
+    if (flags & internal::kNodeReservedMask)
+      return fail_in(Status::reserved_bits_set, c, fixed + 28, node + "reserved Node_Flags bits are set");
+    j.end_site = (flags & internal::kNodeEndSite) != 0;
+    if (j.end_site && j.parent < 0) return fail_in(Status::corrupt, c, fixed, node + "an End Site must have a parent");
+    if (count > internal::kMaxNodeChannels)
+      return fail_in(Status::corrupt, c, fixed + 29, node + "more than 6 channels");
+    if (j.end_site && count != 0) return fail_in(Status::corrupt, c, fixed + 29, node + "an End Site has channels");
+    const uint8_t* types = nullptr;
+    if (!r.bytes(count, types))
+      return fail_in(Status::corrupt, c, fixed + 30, node + "the channel list runs past the end of SKEL");
+    j.channels.resize(count);
+    for (uint32_t k = 0; k < count; ++k) {
+      if (types[k] > internal::kMaxChannelType)
+        return fail_in(Status::reserved_bits_set, c, fixed + 30 + k,
+                       node + "reserved channel type " + std::to_string(types[k]));
+      j.channels[k] = static_cast<ChannelType>(types[k]);
+    }
+    channel_sum += count;
+  }
+  if (!r.at_end()) return fail_in(Status::corrupt, c, r.pos(), "bytes after the last node record");
+  if (channel_sum != channel_count_)
+    return fail_in(Status::corrupt, c, 0,
+                   "the nodes have " + std::to_string(channel_sum) + " channels, CLIP says " + std::to_string(channel_count_));
+  parts.skeleton.assign_channel_columns();
+  return Status::ok;
+}
+
+Status Loader::parse_chan(const Content& c, Clip::Parts& parts) {
+  const uint64_t channels = channel_count_;
+  if (c.size != channels * internal::kChanBytesPerChannel)
+    return fail_in(Status::corrupt, c, 0, "CHAN must be 17 x Channel_Count bytes");
+  const uint8_t* p = c.data;
+  parts.tracks.resize(channels);
+  steps_.resize(channels);
+  uint64_t key_sum = 0;
+  for (uint64_t i = 0; i < channels; ++i) {
+    const std::string ch = "channel " + std::to_string(i) + ": ";
+    const size_t at_interp = i, at_tension = channels + 4 * i, at_step = 5 * channels + 8 * i,
+                 at_count = 13 * channels + 4 * i;
+    const uint8_t interp = p[at_interp];
+    const float tension = internal::load_le<float>(p + at_tension);
+    const double step = internal::load_le<double>(p + at_step);
+    const uint32_t count = internal::load_le<uint32_t>(p + at_count);
+    if (interp > internal::kMaxInterpolation)
+      return fail_in(Status::reserved_bits_set, c, at_interp, ch + "reserved Interpolation " + std::to_string(interp));
+    if (!std::isfinite(tension) || tension < -1.0f || tension > 1.0f)
+      return fail_in(Status::corrupt, c, at_tension, ch + "Tension must be finite and in [-1, 1]");
+    if (!std::isfinite(step) || !(step > 0.0))
+      return fail_in(Status::corrupt, c, at_step, ch + "Step must be finite and > 0");
+    if (count > parts.frame_count)
+      return fail_in(Status::corrupt, c, at_count, ch + "more keys than frames");
+    ChannelTrack& t = parts.tracks[i];
+    t.first_key = static_cast<uint32_t>(key_sum);  // key_sum <= Key_Count < 2^32 checked below
+    t.key_count = count;
+    t.interp = static_cast<Interpolation>(interp);
+    t.s = tension_to_s(tension);
+    steps_[i] = step;
+    key_sum += count;
+    if (key_sum > key_count_)
+      return fail_in(Status::corrupt, c, at_count, ch + "the channels' Key_Count add up to more than CLIP's");
+  }
+  if (key_sum != key_count_)
+    return fail_in(Status::corrupt, c, 13 * channels, "the channels' Key_Count add up to less than CLIP's");
+  return Status::ok;
+}
+
+const char* varint_problem(internal::VarintError e) {
+  switch (e) {
+    case internal::VarintError::cut: return "a varint runs past the end of the section";
+    case internal::VarintError::overlong: return "an over-long varint";
+    case internal::VarintError::too_big: return "a varint too large for its field";
+    case internal::VarintError::none: break;
+  }
+  return "";
+}
+
+Status Loader::parse_ktim(const Content& c, Clip::Parts& parts) {
+  if (key_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KTIM is too short for Key_Count varints");
+  parts.key_frames.resize(static_cast<size_t>(key_count_));
+  uint32_t* out = parts.key_frames.data();
+  const uint64_t frames = parts.frame_count;
+  size_t pos = 0;
+  for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
+    const ChannelTrack& t = parts.tracks[ch];
+    uint64_t frame = 0;
+    for (uint32_t i = 0; i < t.key_count; ++i) {
+      const size_t at = pos;
+      uint64_t v = 0;
+      const auto e = internal::get_varint(c.data, c.size, pos, internal::kMaxVarint32Bytes, v);
+      if (e != internal::VarintError::none) return fail_in(Status::corrupt, c, at, varint_problem(e));
+      frame = i == 0 ? v : frame + v + 1;  // < 2^33: no overflow
+      if (frame >= frames)
+        return fail_in(Status::corrupt, c, at,
+                       "channel " + std::to_string(ch) + ": key frame " + std::to_string(frame) + " >= Frame_Count");
+      out[t.first_key + i] = static_cast<uint32_t>(frame);
+    }
+  }
+  if (pos != c.size) return fail_in(Status::corrupt, c, pos, "bytes after the last key frame");
+  return Status::ok;
+}
+
+Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
+  if (key_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KVAL is too short for Key_Count varints");
+  parts.key_values.resize(static_cast<size_t>(key_count_));
+  float* out = parts.key_values.data();
+  size_t pos = 0;
+  for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
+    const ChannelTrack& t = parts.tracks[ch];
+    const double step = steps_[ch];
+    int64_t q = 0;
+    for (uint32_t i = 0; i < t.key_count; ++i) {
+      const size_t at = pos;
+      uint64_t v = 0;
+      const auto e = internal::get_varint(c.data, c.size, pos, internal::kMaxVarint64Bytes, v);
+      if (e != internal::VarintError::none) return fail_in(Status::corrupt, c, at, varint_problem(e));
+      // zigzag: |d| = (v + 1) / 2 without overflow.
+      if ((v >> 1) + (v & 1) > internal::kMaxAbsDelta)
+        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": a delta beyond 2^54");
+      q += internal::zigzag_decode(v);
+      if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ)
+        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": |q| > 2^53");
+      const float value = dequantize(q, step);
+      if (!std::isfinite(value))
+        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": a key value is not finite");
+      out[t.first_key + i] = value;
+    }
+  }
+  if (pos != c.size) return fail_in(Status::corrupt, c, pos, "bytes after the last key value");
+  return Status::ok;
+}
+
+Status Loader::run(Clip::Parts& parts) {
+  Status s = read_header_and_table();
+  if (s != Status::ok) return s;
+  parts.version_major = 1;
+  parts.version_minor = minor_;
+  static const char* const kNames[5] = {"CLIP", "SKEL", "CHAN", "KTIM", "KVAL"};
+  using Parser = Status (Loader::*)(const Content&, Clip::Parts&);
+  static const Parser kParsers[5] = {&Loader::parse_clip, &Loader::parse_skel, &Loader::parse_chan,
+                                     &Loader::parse_ktim, &Loader::parse_kval};
+  // Sections in table order (the critical ones are in order by now); unknown ancillary
+  // sections are skipped without being decompressed.
+  for (size_t i = 0; i < table_.size(); ++i) {
+    const TableEntry& e = table_[i];
+    Content c;
+    if (static_cast<int>(i) == note_index_) {
+      if ((s = get_content(e, "NOTE", c)) != Status::ok) return s;
+      parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);
+    } else {
+      for (size_t k = 0; k < 5; ++k) {
+        if (critical_index_[k] != static_cast<int>(i)) continue;
+        if ((s = get_content(e, kNames[k], c)) != Status::ok) return s;
+        if ((s = (this->*kParsers[k])(c, parts)) != Status::ok) return s;
+      }
+    }
+    buffers_.clear();  // a decompressed section is not needed once parsed
+  }
+  return Status::ok;
+}
+
+}  // namespace
+
+Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits) {
+  out = Clip{};
+  if (err != nullptr) *err = ErrorInfo{};
+  try {
+    Clip::Parts parts;
+    Loader loader(bytes, limits, err);
+    const Status s = loader.run(parts);
+    if (s != Status::ok) return s;
+    out = Clip::from_parts(std::move(parts));
+  } catch (const std::bad_alloc&) {
+    out = Clip{};
+    if (err != nullptr) {
+      err->status = Status::limit_exceeded;
+      err->section = "file";
+      err->byte_offset = 0;
+      err->detail = "out of memory";
+    }
+    return Status::limit_exceeded;
+  }
+  return Status::ok;
+}
+
+Status Clip::load_file(const std::string& path, Clip& out, ErrorInfo* err, const DecodeLimits& limits) {
+  out = Clip{};
+  auto io_fail = [&](Status s, std::string detail) {
+    if (err != nullptr) *err = ErrorInfo{s, 0, "file", path + ": " + detail};
+    return s;
+  };
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) return io_fail(Status::io_error, "cannot open");
+  if (std::fseek(f.get(), 0, SEEK_END) != 0) return io_fail(Status::io_error, "cannot seek");
+  const long end = std::ftell(f.get());
+  if (end < 0 || std::fseek(f.get(), 0, SEEK_SET) != 0) return io_fail(Status::io_error, "cannot tell its size");
+  if (static_cast<unsigned long>(end) > limits.max_decompressed_bytes)
+    return io_fail(Status::limit_exceeded, "larger than max_decompressed_bytes");
+  std::vector<uint8_t> bytes;
+  try {
+    bytes.resize(static_cast<size_t>(end));
+  } catch (const std::bad_alloc&) {
+    return io_fail(Status::limit_exceeded, "out of memory");
+  }
+  if (!bytes.empty() && std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size())
+    return io_fail(Status::io_error, "read error");
+  return load(bytes, out, err, limits);
+}
+
+}  // namespace keyanim
