@@ -1,0 +1,70 @@
+// The codec core: choose key frames per channel, fit tensions, quantize key values, and (in the
+// default mode) guarantee a maximum world-space joint error for what a decoder will produce.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "keyanim/cardinal.h"
+#include "keyanim/offline/metrics.h"
+#include "keyanim/offline/motion.h"
+
+namespace keyanim::offline {
+
+enum class KeyMode : uint8_t {
+  error = 0,      // fewest keys such that every joint and End Site stays within the tolerance
+  uniform = 1,    // every N-th frame
+  manual = 2,     // the user's frames
+  curvature = 3,  // curvature feature points (curvature.h)
+};
+
+struct EncodeSettings {
+  KeyMode key_mode = KeyMode::error;       // Defaults to error-bounded.
+  double tolerance = 0.05;                 // Defaults to 0.05 (percent of the skeleton size).
+  bool tolerance_in_percent = true;        // Defaults to true; false: file length units.
+  uint32_t uniform_interval = 10;          // uniform mode: Defaults to every 10th frame (>= 1).
+  std::vector<uint32_t> manual_frames;     // manual mode: frame numbers (validated).
+  bool fit_tension = false;                // Defaults to false: fixed tension (below).
+  float tension = 0.0f;                    // Defaults to 0 (Catmull-Rom). Range [-1, 1].
+  TangentRule tangent_rule = TangentRule::step_adjusted;  // Defaults to step-adjusted.
+  bool allow_linear = true;                // Defaults to true: a channel may pick linear if cheaper.
+  bool force_linear = false;               // Defaults to false. True: every channel linear (comparisons).
+  int zstd_level = 19;                     // Defaults to 19 (1..22).
+
+  // Empty if valid, else what is wrong.
+  std::string validate() const;
+};
+
+// One channel as the container stores it.
+struct EncodedChannel {
+  Interpolation interp = Interpolation::cardinal;
+  float tension = 0.0f;
+  double step = 1.0;             // quantization step; key value = dequantize(q, step)
+  std::vector<uint32_t> frames;  // key frames, strictly increasing; empty = all zeros
+  std::vector<int64_t> q;        // quantized key values
+};
+
+struct EncodedClip {
+  Skeleton skeleton;
+  uint32_t frame_count = 0;
+  double frame_time = 0.0;
+  TangentRule tangent_rule = TangentRule::step_adjusted;
+  std::vector<EncodedChannel> channels;
+  std::string notes;  // informative key=value lines (settings, achieved error)
+};
+
+struct EncodeResult {
+  EncodedClip clip;
+  ErrorReport error;          // measured by FK on exactly what a decoder reproduces
+  double tolerance_units = 0; // the tolerance in file length units
+  uint64_t total_keys = 0;
+  uint32_t iterations = 0;    // verify-and-tighten rounds (error mode)
+};
+
+// Returns false with `error` set for invalid settings or a motion the codec cannot take.
+bool encode(const Motion& motion, const EncodeSettings& settings, EncodeResult& out, std::string& error);
+
+// Unwraps a rotation channel in place so that no step exceeds 180 degrees.
+void unwrap_degrees(std::vector<double>& signal);
+
+}  // namespace keyanim::offline

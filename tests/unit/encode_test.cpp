@@ -1,0 +1,186 @@
+// The codec core: key modes, constant channels, unwrapping, and the error guarantee measured on
+// what a decoder makes of the written bytes.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "keyanim/offline/container.h"
+#include "keyanim/offline/decode.h"
+#include "keyanim/offline/encode.h"
+#include "keyanim/offline/fk.h"
+#include "keyanim/offline/metrics.h"
+
+using namespace keyanim;
+using namespace keyanim::offline;
+
+namespace {
+
+// Root with position + ZXY rotation, a 10-unit bone with ZXY rotation, then a 10-unit End Site.
+Motion arm_motion(uint32_t frames) {
+  Motion m;
+  Joint root{"Hips", -1, {0, 0, 0}, {ChannelType::x_position, ChannelType::y_position, ChannelType::z_position,
+                                     ChannelType::z_rotation, ChannelType::x_rotation, ChannelType::y_rotation}};
+  Joint arm{"Arm", 0, {0, 10, 0}, {ChannelType::z_rotation, ChannelType::x_rotation, ChannelType::y_rotation}};
+  Joint end{"", 1, {0, 10, 0}, {}, true};
+  m.skeleton.joints = {root, arm, end};
+  m.skeleton.assign_channel_columns();
+  m.frame_count = frames;
+  m.frame_time = 1.0 / 120.0;
+  m.values.resize(size_t(frames) * 9);
+  for (uint32_t f = 0; f < frames; ++f) {
+    const double t = f / 120.0;
+    double* row = m.frame(f);
+    row[0] = 5.0 * t;                          // walking forward
+    row[1] = 3.0;                              // constant height
+    row[2] = 0.0;                              // all zeros
+    row[3] = 20.0 * std::sin(2.0 * t);         // swaying
+    row[4] = 0.0;
+    row[5] = 170.0 + 40.0 * t;                 // crosses +180: wrapped below
+    row[6] = 60.0 * std::sin(3.0 * t) + 0.2 * std::sin(40.0 * t);
+    row[7] = 15.0 * std::cos(1.5 * t);
+    row[8] = 0.0;
+    if (row[5] > 180.0) row[5] -= 360.0;
+  }
+  return m;
+}
+
+// Encode, write, load, decode: the motion a user gets back.
+Motion round_trip(const Motion& m, const EncodeSettings& s, EncodeResult& r) {
+  std::string error;
+  REQUIRE(encode(m, s, r, error));
+  const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level);
+  Clip clip;
+  REQUIRE(Clip::load(bytes, clip) == Status::ok);
+  Motion out;
+  REQUIRE(decode_motion(clip, {}, out, error));
+  return out;
+}
+
+}  // namespace
+
+TEST_SUITE("encode") {
+  TEST_CASE("unwrap keeps steps within 180 degrees and leaves the first value") {
+    std::vector<double> y{170.0, -170.0, -150.0, 179.0, -179.0};
+    unwrap_degrees(y);
+    CHECK(y[0] == 170.0);
+    CHECK(y[1] == doctest::Approx(190.0));
+    CHECK(y[2] == doctest::Approx(210.0));
+    CHECK(y[3] == doctest::Approx(179.0));  // -150 -> 179 is +329 = -31 wrapped: 210 - 31
+    CHECK(y[4] == doctest::Approx(181.0));
+  }
+
+  TEST_CASE("error mode keeps every joint within the tolerance in file units") {
+    const Motion m = arm_motion(600);
+    for (double tol : {0.5, 0.05, 0.005}) {
+      EncodeSettings s;
+      s.tolerance = tol;
+      s.tolerance_in_percent = false;
+      EncodeResult r;
+      const Motion back = round_trip(m, s, r);
+      const ErrorReport e = measure_error(m, back);
+      CAPTURE(tol);
+      CHECK(e.max_error <= tol);
+      CHECK(e.max_error == doctest::Approx(r.error.max_error));  // the encoder's report is the truth
+      CHECK(r.total_keys < 600u * 9u);
+    }
+  }
+
+  TEST_CASE("tighter tolerances cost more keys") {
+    const Motion m = arm_motion(600);
+    EncodeSettings loose, tight;
+    loose.tolerance = 0.5, tight.tolerance = 0.01;
+    loose.tolerance_in_percent = tight.tolerance_in_percent = false;
+    EncodeResult a, b;
+    round_trip(m, loose, a);
+    round_trip(m, tight, b);
+    CHECK(a.total_keys < b.total_keys);
+  }
+
+  TEST_CASE("constant and zero channels cost one key and none") {
+    const Motion m = arm_motion(300);
+    EncodeSettings s;
+    EncodeResult r;
+    round_trip(m, s, r);
+    CHECK(r.clip.channels[1].frames.size() == 1);  // constant height
+    CHECK(r.clip.channels[2].frames.empty());      // all zeros
+    CHECK(r.clip.channels[8].frames.empty());
+  }
+
+  TEST_CASE("the wrapped channel is stored unwrapped and decodes to the same rotation") {
+    const Motion m = arm_motion(600);
+    EncodeSettings s;
+    s.tolerance = 0.01;
+    s.tolerance_in_percent = false;
+    EncodeResult r;
+    const Motion back = round_trip(m, s, r);
+    // Unwrapped, the channel is a straight line: a handful of keys, not one per wrap.
+    CHECK(r.clip.channels[5].frames.size() <= 4);
+    CHECK(back.value(599, 5) > 180.0);
+    const ErrorReport e = measure_error(m, back);
+    CHECK(e.channel_max[5] < 0.01);
+  }
+
+  TEST_CASE("uniform mode puts keys every N frames on every moving channel") {
+    const Motion m = arm_motion(101);
+    EncodeSettings s;
+    s.key_mode = KeyMode::uniform;
+    s.uniform_interval = 25;
+    EncodeResult r;
+    round_trip(m, s, r);
+    const std::vector<uint32_t> want{0, 25, 50, 75, 100};
+    CHECK(r.clip.channels[3].frames == want);
+    CHECK(r.clip.channels[6].frames == want);
+    CHECK(r.clip.channels[2].frames.empty());
+  }
+
+  TEST_CASE("manual mode validates and uses the given frames") {
+    const Motion m = arm_motion(50);
+    EncodeSettings s;
+    s.key_mode = KeyMode::manual;
+    s.manual_frames = {30, 10, 10};
+    EncodeResult r;
+    round_trip(m, s, r);
+    CHECK(r.clip.channels[6].frames == std::vector<uint32_t>{0, 10, 30, 49});
+    s.manual_frames = {50};
+    std::string error;
+    CHECK_FALSE(encode(m, s, r, error));
+    CHECK(error.find("50") != std::string::npos);
+  }
+
+  TEST_CASE("curvature mode keys land in the channel and report their error") {
+    const Motion m = arm_motion(600);
+    EncodeSettings s;
+    s.key_mode = KeyMode::curvature;
+    EncodeResult r;
+    const Motion back = round_trip(m, s, r);
+    CHECK(r.clip.channels[6].frames.front() == 0);
+    CHECK(r.clip.channels[6].frames.back() == 599);
+    CHECK(measure_error(m, back).max_error == doctest::Approx(r.error.max_error));
+  }
+
+  TEST_CASE("one frame and zero frame motions encode") {
+    Motion one = arm_motion(1);
+    EncodeSettings s;
+    EncodeResult r;
+    const Motion back = round_trip(one, s, r);
+    CHECK(back.frame_count == 1);
+    CHECK(measure_error(one, back).max_error <= r.tolerance_units);
+    Motion none = arm_motion(0);
+    std::string error;
+    CHECK(encode(none, s, r, error));
+  }
+
+  TEST_CASE("invalid settings are refused with a reason") {
+    const Motion m = arm_motion(10);
+    EncodeSettings s;
+    EncodeResult r;
+    std::string error;
+    s.tolerance = -1;
+    CHECK_FALSE(encode(m, s, r, error));
+    CHECK(error.find("tolerance") != std::string::npos);
+    s = {};
+    s.tension = 2.0f;
+    CHECK_FALSE(encode(m, s, r, error));
+  }
+}
