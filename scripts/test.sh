@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# The whole test suite: build, then every test through CTest. Corpus tests use ../shared/corpus
+# when it exists beside the checkout and are skipped (with a message) otherwise.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+ctest --test-dir build -j"$(nproc)" --output-on-failure
