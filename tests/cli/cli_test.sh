@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# CLI behaviour through the real binary: cli_test.sh KEYANIM DATA_DIR CASE
+# Each case prints what it checks and exits non-zero on the first surprise.
+set -uo pipefail
+K="$1"; DATA="$2"; CASE="$3"
+WALK="$DATA/cmu_02_01_walk.bvh"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+cd "$T"
+
+die() { echo "FAIL: $*" >&2; exit 1; }
+expect_rc() {  # expect_rc CODE command...
+  local want=$1; shift
+  "$@" >"$T/.stdout" 2>"$T/.stderr"; local rc=$?
+  [ "$rc" -eq "$want" ] || { cat "$T/.stderr" >&2; die "'$*' exited $rc, expected $want"; }
+}
+json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
+
+case "$CASE" in
+roundtrip)
+  expect_rc 0 "$K" encode "$WALK" -o walk.kanim
+  expect_rc 0 "$K" decode walk.kanim -o walk.bvh
+  expect_rc 0 "$K" verify walk.kanim --against "$WALK" --max-error 0.05%
+  # The decoded BVH has the original's hierarchy, frame count and frame time.
+  a=$("$K" info "$WALK" --json | json 'd["joints"],d["end_sites"],d["channels"],d["frames"],d["frame_time"],d["size"],d["rotation_orders"]')
+  b=$("$K" info walk.bvh --json | json 'd["joints"],d["end_sites"],d["channels"],d["frames"],d["frame_time"],d["size"],d["rotation_orders"]')
+  [ "$a" = "$b" ] || die "hierarchy differs: $a vs $b"
+  diff <(grep -E 'ROOT|JOINT|End Site|CHANNELS' "$WALK" | tr -d '\r' | tr -s ' \t' ' ' | sed 's/ *$//') \
+       <(grep -E 'ROOT|JOINT|End Site|CHANNELS' walk.bvh | tr -s ' \t' ' ' | sed 's/ *$//') >/dev/null || die "joint lines differ"
+  ;;
+json)
+  "$K" encode "$WALK" -o w.kanim --json >enc.json || die "encode --json"
+  size=$(stat -c %s w.kanim)
+  [ "$(json 'd["kanim_bytes"]' <enc.json)" = "$size" ] || die "encode --json kanim_bytes is not the file size"
+  [ "$(json 'd["error"]["max"] <= d["tolerance"]' <enc.json)" = "True" ] || die "encode reports an error over tolerance"
+  "$K" eval "$WALK" --error 0.05% --json >eval.json || die "eval --json"
+  [ "$(json 'd["files"][0]["results"][0]["kanim_bytes"]' <eval.json)" = "$size" ] || die "eval bytes differ from encode"
+  [ "$(json 'd["files"][0]["frames"]' <eval.json)" = "344" ] || die "eval frames"
+  "$K" info w.kanim --json | json 'd["keys"]["total"]' >keys || die "info --json"
+  [ "$(cat keys)" = "$(json 'd["keys"]' <enc.json)" ] || die "info key total differs from encode"
+  # sample at frame 0 gives the original first-frame values within the tolerance's angle share
+  "$K" sample w.kanim --frame 0 --joint Hips --json | json 'd["joints"][0]["Xposition"]' >x || die "sample --json"
+  orig=$(awk '/^MOTION/{m=1;next} m&&/Frame Time/{getline; print $1; exit}' "$WALK")
+  python3 -c "import sys; sys.exit(0 if abs(float('$(cat x)')-float('$orig'))<0.02 else 1)" || die "sample frame 0 Hips X $(cat x) vs $orig"
+  "$K" sample w.kanim --time 0.5 --world --json | json 'len(d["joints"])' >n || die "sample --world"
+  [ "$(cat n)" = "38" ] || die "sample --world should list 31 joints + 7 End Sites, got $(cat n)"
+  ;;
+exit_codes)
+  expect_rc 1 "$K"
+  expect_rc 0 "$K" --help
+  expect_rc 0 "$K" encode --help
+  expect_rc 0 "$K" -V
+  expect_rc 1 "$K" frobnicate
+  expect_rc 1 "$K" encode "$WALK" --no-such-option
+  expect_rc 1 "$K" encode "$WALK" --error -3
+  expect_rc 1 "$K" encode "$WALK" --keys sometimes
+  expect_rc 2 "$K" encode does-not-exist.bvh -o x.kanim
+  printf 'HIERARCHY\nROOT a\n{\n OFFSET 0 0\n' >bad.bvh
+  expect_rc 2 "$K" encode bad.bvh -o x.kanim
+  grep -q 'bad.bvh:5:1: expected a number' "$T/.stderr" || die "malformed BVH error does not name the end of the file: $(cat "$T/.stderr")"
+  [ ! -e x.kanim ] || die "a failed encode left an output"
+  "$K" encode "$WALK" -o ok.kanim >/dev/null 2>&1
+  head -c 100 ok.kanim >cut.kanim
+  expect_rc 2 "$K" decode cut.kanim -o cut.bvh
+  [ ! -e cut.bvh ] || die "a failed decode left an output"
+  # A newer major version: the version field follows the 8-byte signature (little-endian u16).
+  cp ok.kanim v2.kanim; printf '\x02' | dd of=v2.kanim bs=1 seek=8 conv=notrunc 2>/dev/null
+  expect_rc 3 "$K" info v2.kanim
+  expect_rc 4 "$K" encode "$WALK" -o ok.kanim
+  expect_rc 5 "$K" verify ok.kanim --against "$WALK" --max-error 0.0001%
+  ;;
+no_clobber)
+  echo "precious" >walk.kanim
+  expect_rc 4 "$K" encode "$WALK" -o walk.kanim
+  [ "$(cat walk.kanim)" = "precious" ] || die "existing output was modified without -f"
+  expect_rc 0 "$K" encode -f "$WALK" -o walk.kanim
+  "$K" info walk.kanim >/dev/null || die "forced output is not a valid .kanim"
+  cp "$WALK" w.bvh
+  expect_rc 0 "$K" encode w.bvh            # default name w.kanim
+  expect_rc 4 "$K" decode w.kanim          # default name w.bvh exists: the input is safe
+  cmp -s w.bvh "$WALK" || die "the input BVH was modified"
+  [ -z "$(ls -a | grep '\.tmp\.')" ] || die "temporary files left behind"
+  ;;
+pipe)
+  cat "$WALK" | "$K" encode - -o - | "$K" decode - -o - >piped.bvh || die "pipe failed"
+  "$K" info piped.bvh --json | json 'd["frames"]' >f
+  [ "$(cat f)" = "344" ] || die "piped BVH has $(cat f) frames"
+  ;;
+tween)
+  "$K" encode "$WALK" -o w.kanim 2>/dev/null
+  expect_rc 0 "$K" decode w.kanim -o w30.bvh --fps 30
+  [ "$("$K" info w30.bvh --json | json 'd["frames"]')" = "86" ] || die "30 fps decode frame count"
+  expect_rc 0 "$K" decode w.kanim -o w2.bvh --inbetweens 1
+  [ "$("$K" info w2.bvh --json | json 'd["frames"]')" = "687" ] || die "inbetweens frame count"
+  expect_rc 0 "$K" decode w.kanim -o part.bvh --frames 10:19
+  [ "$("$K" info part.bvh --json | json 'd["frames"]')" = "10" ] || die "--frames count"
+  expect_rc 1 "$K" decode w.kanim -o x.bvh --fps 30 --inbetweens 2
+  expect_rc 1 "$K" decode w.kanim -o x.bvh --frames 5:400
+  ;;
+directory)
+  mkdir -p in/sub; cp "$WALK" in/a.bvh; cp "$WALK" in/sub/b.bvh; echo garbage >in/broken.bvh
+  expect_rc 2 "$K" encode in -o out -j 2
+  [ -f out/a.kanim ] && [ -f out/sub/b.kanim ] || die "good files were not encoded"
+  [ ! -e out/broken.kanim ] || die "the broken file left an output"
+  grep -q 'broken.bvh:1:1' "$T/.stderr" || die "the broken file is not named: $(cat "$T/.stderr")"
+  [ -z "$(find out -name '*.tmp.*')" ] || die "temporary files left behind"
+  expect_rc 2 "$K" eval in -j 2 --error 0.5%
+  grep -q 'a.bvh' "$T/.stdout" || die "eval skipped the good files"
+  ;;
+*) die "unknown case $CASE" ;;
+esac
+echo "ok: $CASE"

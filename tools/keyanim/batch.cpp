@@ -1,0 +1,92 @@
+#include "batch.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+namespace keyanim::cli {
+
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (in == "-" || !fs::is_directory(in, ec)) {
+      out.push_back(in);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (auto it = fs::recursive_directory_iterator(in, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec)) {
+      std::string ext = it->path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+      if (it->is_regular_file(ec) && ext == ".bvh") found.push_back(it->path().string());
+    }
+    if (ec) fail(kBadInput, in + ": cannot list: " + ec.message());
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
+  }
+  return out;
+}
+
+unsigned thread_count(const Args& args) {
+  const uint32_t j = args.get_uint("-j", 0);
+  return j ? j : std::max(1u, std::thread::hardware_concurrency());
+}
+
+int run_batch(size_t count, unsigned threads, const Globals& g, const std::function<void(size_t)>& job,
+              const std::vector<std::string>& names) {
+  std::vector<int> codes(count, kOk);
+  std::atomic<size_t> next{0}, done{0};
+  std::mutex out_mutex;
+  const bool bar = g.verbosity > 0 && count > 1 && isatty(STDERR_FILENO);
+  auto progress = [&] {  // caller holds out_mutex
+    if (!bar) return;
+    const size_t d = done.load();
+    const int width = 30, filled = int(double(d) / double(count) * width);
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu", std::string(size_t(filled), '#').c_str(),
+                 std::string(size_t(width - filled), ' ').c_str(), d, count);
+    if (d == count) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+  auto worker = [&] {
+    for (size_t i; (i = next.fetch_add(1)) < count;) {
+      std::string message;
+      try {
+        job(i);
+      } catch (const Failure& f) {
+        codes[i] = f.code;
+        message = f.message;
+      } catch (const std::exception& e) {
+        codes[i] = kBadInput;
+        message = names[i] + ": " + e.what();
+      }
+      ++done;
+      std::lock_guard<std::mutex> lock(out_mutex);
+      if (!message.empty()) {
+        if (bar) std::fprintf(stderr, "\r%*s\r", 50, "");
+        std::cerr << "keyanim: " << message << "\n";
+      }
+      progress();
+    }
+  };
+  std::vector<std::thread> pool;
+  const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(count)));
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  size_t failed = 0;
+  int first = kOk;
+  for (int c : codes)
+    if (c != kOk) ++failed, first = first == kOk ? c : first;
+  if (failed && count > 1) std::cerr << "keyanim: " << failed << " of " << count << " inputs failed\n";
+  return first;
+}
+
+}  // namespace keyanim::cli

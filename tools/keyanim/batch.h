@@ -1,0 +1,24 @@
+// Running one job per input file on several threads, with a progress bar on a terminal, going
+// on past failures. Used by the commands that accept directories.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+
+namespace keyanim::cli {
+
+// Expands directories into their *.bvh files (recursively, sorted); files stay as given.
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
+
+// Runs job(i) for every i < count on `threads` threads (0: all cores). A job reports failure
+// by throwing cli::Failure; the failure is printed (unless silenced by the caller) and the
+// others go on. Returns the exit code of the first failure by input order, or kOk.
+int run_batch(size_t count, unsigned threads, const Globals& g, const std::function<void(size_t)>& job,
+              const std::vector<std::string>& names);
+
+// -j N: 0 means one thread per core.
+unsigned thread_count(const Args& args);
+
+}  // namespace keyanim::cli

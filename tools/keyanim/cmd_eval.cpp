@@ -1,0 +1,138 @@
+// keyanim eval: compression against reconstruction error, for files and tolerances.
+#include <zstd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "batch.h"
+#include "commands.h"
+#include "keyanim/offline/container.h"
+#include "keyanim/offline/decode.h"
+#include "keyanim/offline/metrics.h"
+#include "report.h"
+#include "settings.h"
+
+namespace keyanim::cli {
+
+const char* const kEvalHelp =
+    "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--keys MODE] [--tension T|fit] [--level N]\n"
+    "                    [-j N] [--json]\n"
+    "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
+    "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
+    "by zstd -19, the max and RMS world-space error with the worst joint and frame, and the\n"
+    "encode and decode times. Nothing is written.\n"
+    "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
+    "  -j N                  threads (default: one per core)\n"
+    "  --json                one JSON object on standard output\n";
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+size_t zstd19_size(const std::vector<uint8_t>& text) {
+  std::vector<uint8_t> out(ZSTD_compressBound(text.size()));
+  const size_t n = ZSTD_compress(out.data(), out.size(), text.data(), text.size(), 19);
+  return ZSTD_isError(n) ? 0 : n;
+}
+
+nlohmann::json eval_file(const std::string& path, const std::vector<offline::EncodeSettings>& runs,
+                         const std::vector<std::string>& labels, const Globals& g) {
+  const std::vector<uint8_t> text = read_input(path);
+  const auto t0 = Clock::now();
+  const offline::Motion m = load_bvh_bytes(path, text, g);
+  const double parse_ms = ms(t0);
+  const double raw = 4.0 * m.frame_count * m.channel_count();
+  const size_t z19 = zstd19_size(text);
+  nlohmann::json file = {{"file", path},
+                         {"frames", m.frame_count},
+                         {"channels", m.channel_count()},
+                         {"frame_time", m.frame_time},
+                         {"raw_f32_bytes", raw},
+                         {"bvh_bytes", text.size()},
+                         {"bvh_zstd19_bytes", z19},
+                         {"parse_ms", parse_ms},
+                         {"results", nlohmann::json::array()}};
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const auto te = Clock::now();
+    offline::EncodeResult enc;
+    std::string error;
+    if (!offline::encode(m, runs[r], enc, error)) fail(kBadInput, path + ": " + error);
+    const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, runs[r].zstd_level);
+    const double encode_ms = ms(te);
+    const auto td = Clock::now();
+    const Clip clip = load_kanim(path + " (encoded)", bytes);
+    offline::Motion back;
+    if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, path + ": " + error);
+    const double decode_ms = ms(td);
+    const offline::ErrorReport e = offline::measure_error(m, back);
+    const double n = double(bytes.size());
+    file["results"].push_back({{"tolerance", labels[r]},
+                               {"tolerance_units", enc.tolerance_units},
+                               {"keys", enc.total_keys},
+                               {"kanim_bytes", bytes.size()},
+                               {"ratio_raw_f32", raw / n},
+                               {"ratio_bvh", double(text.size()) / n},
+                               {"ratio_bvh_zstd19", double(z19) / n},
+                               {"error", error_json(m.skeleton, e)},
+                               {"encode_ms", encode_ms},
+                               {"decode_ms", decode_ms}});
+  }
+  return file;
+}
+
+}  // namespace
+
+int cmd_eval(const Argv& argv, Globals& g) {
+  std::set<std::string> valued{"-j"};
+  valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
+  const Args args(argv, valued, {"--json"});
+  if (args.positional().empty()) fail(kUsage, "eval needs at least one BVH file or directory");
+  std::vector<std::string> labels{"0.05%", "0.5%"};
+  if (auto list = args.get("--error")) {
+    labels.clear();
+    std::stringstream ss(*list);
+    for (std::string t; std::getline(ss, t, ',');) labels.push_back(t);
+    if (labels.empty()) fail(kUsage, "--error needs at least one tolerance");
+  }
+  std::vector<offline::EncodeSettings> runs;
+  for (const std::string& label : labels) {
+    offline::EncodeSettings s = encode_settings(args);  // --keys, --tension, --level
+    parse_tolerance(label, s);
+    if (const std::string why = s.validate(); !why.empty()) fail(kUsage, why);
+    runs.push_back(s);
+  }
+  const std::vector<std::string> files = expand_inputs(args.positional());
+  if (files.empty()) fail(kBadInput, "no .bvh files found");
+  std::vector<nlohmann::json> results(files.size());
+  Globals quiet = g;
+  quiet.verbosity = std::min(g.verbosity, 1);
+  const int code = run_batch(files.size(), thread_count(args), g,
+                             [&](size_t i) { results[i] = eval_file(files[i], runs, labels, quiet); }, files);
+
+  if (args.has("--json")) {
+    nlohmann::json all = nlohmann::json::array();
+    for (const auto& r : results)
+      if (!r.is_null()) all.push_back(r);
+    std::cout << nlohmann::json{{"files", all}}.dump() << "\n";
+    return code;
+  }
+  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s\n", "file", "tolerance", "keys", "bytes", "x raw",
+              "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms");
+  for (const auto& f : results) {
+    if (f.is_null()) continue;
+    std::string name = f["file"].get<std::string>();
+    if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
+    for (const auto& r : f["results"])
+      std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f\n", name.c_str(),
+                  r["tolerance"].get<std::string>().c_str(), r["keys"].get<unsigned long long>(),
+                  r["kanim_bytes"].get<unsigned long long>(), r["ratio_raw_f32"].get<double>(),
+                  r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(), r["error"]["max"].get<double>(),
+                  r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(), r["decode_ms"].get<double>());
+  }
+  return code;
+}
+
+}  // namespace keyanim::cli

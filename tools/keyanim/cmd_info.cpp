@@ -1,0 +1,110 @@
+// keyanim info: what a BVH or .kanim file holds.
+#include <algorithm>
+#include <iostream>
+#include <set>
+
+#include "commands.h"
+#include "keyanim/offline/fk.h"
+#include "keyanim/version.h"
+#include "report.h"
+
+namespace keyanim::cli {
+
+const char* const kInfoHelp =
+    "usage: keyanim info FILE [--json]\n"
+    "Describes a BVH or .kanim file (recognised by its first bytes): skeleton, frames, frame time,\n"
+    "channels, skeleton size; for .kanim also version, keys per channel, tensions and encoder notes.\n"
+    "  --json                one JSON object on standard output\n";
+
+namespace {
+
+// Skeleton facts common to both kinds of file.
+nlohmann::json skeleton_json(const Skeleton& s) {
+  uint32_t joints = 0, end_sites = 0, roots = 0;
+  std::set<std::string> orders;
+  for (const Joint& j : s.joints) {
+    (j.end_site ? end_sites : joints) += 1;
+    roots += j.parent < 0;
+    std::string order;
+    for (ChannelType t : j.channels)
+      if (is_rotation(t)) order += char('X' + channel_axis(t));
+    if (!order.empty()) orders.insert(order);
+  }
+  return {{"joints", joints},
+          {"end_sites", end_sites},
+          {"roots", roots},
+          {"channels", s.channel_count()},
+          {"size", offline::skeleton_size(s)},
+          {"rotation_orders", std::vector<std::string>(orders.begin(), orders.end())}};
+}
+
+void print_text(const nlohmann::json& j) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it->is_object()) {
+      std::cout << it.key() << ":\n";
+      for (auto sub = it->begin(); sub != it->end(); ++sub) std::cout << "  " << sub.key() << ": " << sub->dump() << "\n";
+    } else {
+      std::cout << it.key() << ": " << (it->is_string() ? it->get<std::string>() : it->dump()) << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+int cmd_info(const Argv& argv, Globals& g) {
+  const Args args(argv, {}, {"--json"});
+  if (args.positional().size() != 1) fail(kUsage, "info takes one file");
+  const std::string in = args.positional()[0];
+  const std::vector<uint8_t> bytes = read_input(in);
+  nlohmann::json j;
+  if (!looks_like_kanim(bytes)) {
+    const offline::Motion m = load_bvh_bytes(in, bytes, g);
+    j = {{"file", in}, {"format", "bvh"}, {"bytes", bytes.size()}};
+    j.update(skeleton_json(m.skeleton));
+    j["frames"] = m.frame_count;
+    j["frame_time"] = m.frame_time;
+  } else {
+    const Clip clip = load_kanim(in, bytes);
+    j = {{"file", in},
+         {"format", "kanim"},
+         {"version", std::to_string(clip.version_major()) + "." + std::to_string(clip.version_minor())},
+         {"bytes", bytes.size()},
+         {"checksum", "ok"}};
+    j.update(skeleton_json(clip.skeleton()));
+    j["frames"] = clip.frame_count();
+    j["frame_time"] = clip.frame_time();
+    j["tangent_rule"] = clip.tangent_rule() == TangentRule::step_adjusted ? "step_adjusted" : "uniform";
+    std::vector<uint32_t> keys;
+    uint32_t zero = 0, constant = 0, linear = 0;
+    float t_min = 1.0f, t_max = -1.0f;
+    double t_sum = 0.0;
+    uint32_t curved = 0;
+    for (uint32_t c = 0; c < clip.channel_count(); ++c) {
+      const ChannelTrack& t = clip.track(c);
+      keys.push_back(t.key_count);
+      zero += t.key_count == 0;
+      constant += t.key_count == 1;
+      if (t.key_count < 2) continue;
+      if (t.interp == Interpolation::linear) { ++linear; continue; }
+      const float tension = s_to_tension(t.s);
+      t_min = std::min(t_min, tension), t_max = std::max(t_max, tension), t_sum += tension, ++curved;
+    }
+    std::sort(keys.begin(), keys.end());
+    j["keys"] = {{"total", clip.total_keys()},
+                 {"per_channel_min", keys.empty() ? 0 : keys.front()},
+                 {"per_channel_median", keys.empty() ? 0 : keys[keys.size() / 2]},
+                 {"per_channel_max", keys.empty() ? 0 : keys.back()},
+                 {"zero_channels", zero},
+                 {"constant_channels", constant},
+                 {"linear_channels", linear},
+                 {"cardinal_channels", curved}};
+    if (curved) j["tension"] = {{"min", t_min}, {"mean", t_sum / curved}, {"max", t_max}};
+    j["raw_f32_bytes"] = uint64_t(4) * clip.frame_count() * clip.channel_count();
+    j["memory_bytes"] = clip.memory_bytes();
+    j["encoder_notes"] = clip.encoder_notes();
+  }
+  if (args.has("--json")) std::cout << j.dump() << "\n"; else print_text(j);
+  return kOk;
+}
+
+}  // namespace keyanim::cli

@@ -1,0 +1,80 @@
+// keyanim plot: one channel's original curve against its reconstruction, keys marked, as SVG.
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+
+#include "commands.h"
+#include "figures.h"
+#include "settings.h"
+
+namespace keyanim::cli {
+
+const char* const kPlotHelp =
+    "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--frames A:B] [--error E|E%]\n"
+    "                    [--keys MODE] [--tension T|fit] [-f]\n"
+    "Encodes IN with the given settings and draws one channel over the frames: the original curve\n"
+    "(rotations unwrapped), the decoder's reconstruction and one dot per key. Values in degrees for\n"
+    "rotations, in file length units for positions.\n"
+    "  --channel JOINT:CHANNEL  required; CHANNEL is Xposition, Yposition, Zposition, Xrotation,\n"
+    "                        Yrotation or Zrotation (e.g. RightArm:Zrotation)\n"
+    "  --frames A:B          draw frames A..B only, inclusive (default: all; A: or :B leave one\n"
+    "                        end open). The whole clip is encoded either way.\n"
+    "  -o, --output FILE     SVG output (default: IN without extension + -JOINT-CHANNEL.svg;\n"
+    "                        '-' = standard output)\n";
+
+namespace {
+
+// A joint name made safe for a file name: anything but letters, digits, '-', '_' becomes '_'.
+std::string file_safe(const std::string& s) {
+  std::string out = s;
+  for (char& c : out)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_')) c = '_';
+  return out;
+}
+
+}  // namespace
+
+int cmd_plot(const Argv& argv, Globals& g) {
+  std::set<std::string> valued{"-o", "--output", "--channel", "--frames"};
+  valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
+  const Args args(argv, valued, {});
+  if (args.positional().size() != 1) fail(kUsage, "plot takes one BVH file");
+  const auto spec = args.get("--channel");
+  if (!spec) fail(kUsage, "plot needs --channel JOINT:CHANNEL");
+  const offline::EncodeSettings settings = encode_settings(args);
+  const std::string in = args.positional()[0];
+
+  const offline::Motion motion = load_bvh(in, g);
+  std::string error;
+  const std::optional<uint32_t> channel = find_channel(motion.skeleton, *spec, error);
+  if (!channel) fail(kUsage, in + ": " + error);
+  if (motion.frame_count == 0) fail(kBadInput, in + ": no frames to plot");
+
+  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  if (out.empty()) {
+    const size_t colon = spec->rfind(':');
+    out = in == "-" ? "-"
+                    : swap_extension(in, "") + "-" + file_safe(spec->substr(0, colon)) + "-" +
+                          spec->substr(colon + 1) + ".svg";
+  }
+  const std::string label = in == "-" ? "(stdin)" : std::filesystem::path(in).filename().string();
+  FrameRange range;
+  if (auto text = args.get("--frames")) {
+    const size_t colon = text->find(':');
+    if (colon == std::string::npos) fail(kUsage, "--frames expects A:B, got '" + *text + "'");
+    if (colon > 0) range.first = parse_uint("--frames", text->substr(0, colon));
+    if (colon + 1 < text->size()) range.last = parse_uint("--frames", text->substr(colon + 1));
+    if (range.first > range.last || range.first >= motion.frame_count)
+      fail(kUsage, "--frames " + *text + " holds no frame of " + in + " (frames 0.." +
+                       std::to_string(motion.frame_count - 1) + ")");
+  }
+  ChannelPlot plot;
+  if (!plot_channel(motion, settings, *channel, label, plot, error, range)) fail(kBadInput, in + ": " + error);
+  write_output(out, plot.svg, false, g);
+  if (g.verbosity > 0)
+    std::cerr << in << " -> " << out << ": " << *spec << ", " << plot.key_count << " keys shown of "
+              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "\n";
+  return kOk;
+}
+
+}  // namespace keyanim::cli

@@ -1,0 +1,17 @@
+// JSON and one-line text renderings of what the library measured, shared by the commands.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "keyanim/offline/encode.h"
+#include "keyanim/skeleton.h"
+
+namespace keyanim::cli {
+
+// Display name of a node: its name, or "End Site of PARENT".
+std::string node_name(const Skeleton& s, uint32_t node);
+nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e);
+// "max 0.081 (LeftHand, frame 713), rms 0.012"
+std::string error_text(const Skeleton& s, const offline::ErrorReport& e);
+
+}  // namespace keyanim::cli

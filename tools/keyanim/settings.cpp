@@ -1,0 +1,65 @@
+#include "settings.h"
+
+namespace keyanim::cli {
+
+const char* const kEncodeOptionsHelp =
+    "  --error E|E%          tolerance: max world-space joint error, in file length units, or in\n"
+    "                        percent of the skeleton size (largest side of the rest-pose box).\n"
+    "                        Default 0.05%. Range: > 0 (percent: at most 100).\n"
+    "  --keys MODE           error (default): fewest keys within --error;\n"
+    "                        uniform:N every N-th frame (N >= 1); manual:F1,F2,... those frames;\n"
+    "                        curvature: curvature feature points. First and last frame always.\n"
+    "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
+    "                        least squares per channel, kept where it saves keys.\n"
+    "  --level N             zstd level, 1..22. Default 19.\n";
+
+void parse_tolerance(const std::string& text, offline::EncodeSettings& s) {
+  std::string t = text;
+  s.tolerance_in_percent = !t.empty() && t.back() == '%';
+  if (s.tolerance_in_percent) t.pop_back();
+  s.tolerance = parse_double("--error", t);
+  if (!(s.tolerance > 0.0)) fail(kUsage, "--error must be positive, got '" + text + "'");
+}
+
+void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
+  const size_t colon = text.find(':');
+  const std::string mode = text.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? "" : text.substr(colon + 1);
+  if (mode == "error" && colon == std::string::npos) {
+    s.key_mode = offline::KeyMode::error;
+  } else if (mode == "curvature" && colon == std::string::npos) {
+    s.key_mode = offline::KeyMode::curvature;
+  } else if (mode == "uniform" && !arg.empty()) {
+    s.key_mode = offline::KeyMode::uniform;
+    s.uniform_interval = parse_uint("--keys uniform:N", arg);
+    if (s.uniform_interval < 1) fail(kUsage, "--keys uniform:N needs N >= 1");
+  } else if (mode == "manual" && !arg.empty()) {
+    s.key_mode = offline::KeyMode::manual;
+    size_t start = 0;
+    while (start <= arg.size()) {
+      const size_t comma = std::min(arg.find(',', start), arg.size());
+      s.manual_frames.push_back(parse_uint("--keys manual:F1,F2,...", arg.substr(start, comma - start)));
+      start = comma + 1;
+    }
+  } else {
+    fail(kUsage, "--keys expects error, uniform:N, manual:F1,F2,... or curvature, got '" + text + "'");
+  }
+}
+
+offline::EncodeSettings encode_settings(const Args& args) {
+  offline::EncodeSettings s;
+  if (auto e = args.get("--error")) parse_tolerance(*e, s);
+  if (auto k = args.get("--keys")) parse_key_mode(*k, s);
+  if (auto t = args.get("--tension")) {
+    if (*t == "fit") {
+      s.fit_tension = true;
+    } else {
+      s.tension = static_cast<float>(parse_double("--tension", *t));
+    }
+  }
+  if (auto l = args.get("--level")) s.zstd_level = static_cast<int>(parse_uint("--level", *l));
+  if (const std::string why = s.validate(); !why.empty()) fail(kUsage, why);
+  return s;
+}
+
+}  // namespace keyanim::cli

@@ -1,0 +1,23 @@
+// Encoder options shared by `encode`, `eval` and `plot`: --error, --keys, --tension, --level.
+#pragma once
+#include <string>
+
+#include "cli.h"
+#include "keyanim/offline/encode.h"
+
+namespace keyanim::cli {
+
+// Options that take a value, to declare in Args.
+inline const char* const kEncodeValuedOptions[] = {"--error", "--keys", "--tension", "--level"};
+
+// Reads the options (with their documented defaults) and validates them: usage error if wrong.
+offline::EncodeSettings encode_settings(const Args& args);
+// "0.05%" or "0.1" -> settings.tolerance / tolerance_in_percent; usage error if malformed.
+void parse_tolerance(const std::string& text, offline::EncodeSettings& s);
+// "error", "uniform:N", "manual:F1,F2,...", "curvature".
+void parse_key_mode(const std::string& text, offline::EncodeSettings& s);
+
+// The help lines for these options (defaults and ranges).
+extern const char* const kEncodeOptionsHelp;
+
+}  // namespace keyanim::cli
