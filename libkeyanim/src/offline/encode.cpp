@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/curvature.h"
@@ -258,12 +259,13 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
         if (column[f] != old || round == 0) old = column[f], check[f] = 1;
       }
     }
-    std::vector<std::vector<double>> cap(n_ch);  // new tolerance at a frame, +inf = unchanged
+    // (channel, frame, tightened tolerance) for every channel that moves an over-budget node.
+    std::vector<std::tuple<uint32_t, uint32_t, double>> tighten;
     bool over = false;
     for (uint32_t f = 0; f < n_fr; ++f) {
       if (!check[f]) continue;
       check[f] = 0;
-      world_positions(m.skeleton, decoded.frame(f), pos);
+      world_positions(m.skeleton, decoded.values.data() + size_t(f) * n_ch, pos);
       for (size_t d = 0; d < n_nodes; ++d) {
         const Vec3& a = orig_pos[f * n_nodes + d];
         const double e = std::hypot(pos[d][0] - a[0], pos[d][1] - a[1], pos[d][2] - a[2]);
@@ -271,10 +273,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
         over = true;
         check[f] = 1;
         const double r = kTightenMargin * tol_units / e;
-        for (uint32_t c : moving[d]) {
-          if (cap[c].empty()) cap[c].assign(n_fr, HUGE_VAL);
-          cap[c][f] = std::min(cap[c][f], r * tol[c][f]);
-        }
+        for (uint32_t c : moving[d]) tighten.emplace_back(c, f, r * tol[c][f]);
       }
     }
     if (!over) break;
@@ -283,12 +282,13 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
               " units after " + std::to_string(kMaxRounds) + " rounds (below float32 precision?)";
       return false;
     }
-    for (uint32_t c = 0; c < n_ch; ++c) {
-      if (cap[c].empty()) continue;
-      changed[c].clear();
-      for (uint32_t f = 0; f < n_fr; ++f)
-        if (cap[c][f] < tol[c][f]) tol[c][f] = cap[c][f], changed[c].push_back(f);
-      dirty[c] = !changed[c].empty();
+    // Sorted by channel then frame: each channel's changed frames come out sorted.
+    std::sort(tighten.begin(), tighten.end());
+    for (const auto& [c, f, t] : tighten) {
+      if (!(t < tol[c][f])) continue;
+      if (!dirty[c]) changed[c].clear(), dirty[c] = true;  // first tightening of this round
+      tol[c][f] = t;
+      if (changed[c].empty() || changed[c].back() != f) changed[c].push_back(f);
     }
   }
 
