@@ -59,26 +59,22 @@ void CurveFit::measure_all() {
   for (uint32_t f = first_; f != kNone && next_[f] != kNone; f = next_[f]) measure(f);
 }
 
-// The decoder's arithmetic on the (up to) four keys around the segment [start, next]: the same
-// end-point duplication as eval_segment applies where the list ends.
-float CurveFit::value_at(uint32_t start, uint32_t f) const {
+void CurveFit::measure(uint32_t start, bool push) {
+  // The decoder's arithmetic on the (up to) four keys around the segment [start, end]: the
+  // same end-point duplication as eval_segment applies where the list ends.
+  const uint32_t end = next_[start];
   uint32_t frames[4];
   float values[4];
   uint32_t n = 0, j = 0;
   if (prev_[start] != kNone) frames[n] = prev_[start], values[n++] = v_[prev_[start]], j = 1;
-  const uint32_t end = next_[start];
   frames[n] = start, values[n++] = v_[start];
   frames[n] = end, values[n++] = v_[end];
   if (next_[end] != kNone) frames[n] = next_[end], values[n++] = v_[next_[end]];
-  return eval_segment(frames, values, n, j, segment_u(start, end, float(f)), interp_, s_, rule_);
-}
-
-void CurveFit::measure(uint32_t start, bool push) {
-  const uint32_t end = next_[start];
   double worst = 0.0;
   uint32_t arg = start + 1;
   for (uint32_t f = start + 1; f < end; ++f) {
-    const double r = std::fabs(double(value_at(start, f)) - (*y_)[f]) / (*tol_)[f];
+    const float v = eval_segment(frames, values, n, j, segment_u(start, end, float(f)), interp_, s_, rule_);
+    const double r = std::fabs(double(v) - (*y_)[f]) / (*tol_)[f];
     if (r > worst) worst = r, arg = f;
   }
   seg_ratio_[start] = worst, seg_arg_[start] = arg;

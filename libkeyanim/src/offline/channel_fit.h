@@ -46,7 +46,6 @@ class CurveFit {
   void quantize(uint32_t f);
   void link(uint32_t f, uint32_t a, uint32_t b);  // make f a key between keys a and b
   void unlink(uint32_t f);
-  float value_at(uint32_t start, uint32_t f) const;
   // Segment starting at key frame `start`: worst ratio |error| / tol over the frames inside
   // it; queued if over budget.
   void measure(uint32_t start, bool push = true);
