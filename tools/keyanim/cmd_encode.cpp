@@ -20,7 +20,8 @@ const char* const kEncodeHelp =
     "                        IN may be a directory: every .bvh below it is encoded to the same\n"
     "                        relative path below -o OUTDIR, in parallel; bad files are reported\n"
     "                        and skipped, and the exit code is then non-zero.\n"
-    "  -j N                  threads for a directory (default: one per core)\n"
+    "  -j N                  threads (default: one per core): a file's channels, or a\n"
+    "                        directory's files\n"
     "  --json                one JSON object on standard output\n";
 
 namespace {
@@ -69,7 +70,7 @@ int cmd_encode(const Argv& argv, Globals& g) {
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {"--json"});
   if (args.positional().size() != 1) fail(kUsage, "encode takes one input file or directory");
-  const offline::EncodeSettings settings = encode_settings(args);
+  offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];
   std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
   const bool json = args.has("--json");
@@ -77,6 +78,7 @@ int cmd_encode(const Argv& argv, Globals& g) {
   std::error_code ec;
   if (in == "-" || !std::filesystem::is_directory(in, ec)) {
     if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".kanim");
+    settings.threads = thread_count(args);  // one file: its channels in parallel
     const nlohmann::json j = encode_one(in, out, settings, g);
     if (json) std::cout << j.dump() << "\n";
     else if (g.verbosity > 0) print_line(j);

@@ -6,9 +6,11 @@
 #include "keyanim/offline/encode.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "keyanim/offline/container.h"
@@ -227,24 +229,34 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   std::vector<Vec3> pos;
   std::vector<uint8_t> check(n_fr, 1);  // frames to verify: values changed, or over last round
   std::vector<uint32_t> refit;
+  const uint32_t threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   uint32_t round = 0;
   for (;; ++round) {
     refit.clear();
-    for (uint32_t c = 0; c < n_ch; ++c) {
-      if (!dirty[c]) continue;
-      dirty[c] = false;
-      refit.push_back(c);
-      // The step halves (rather than follows the smallest tolerance) so that tightening a few
-      // frames rarely requantizes the whole channel.
-      const double min_tol = n_fr ? *std::min_element(tol[c].begin(), tol[c].end()) : base_tol[c];
-      double step = kStepFraction * base_tol[c];
-      while (step > kStepFraction * min_tol) step *= 0.5;
-      switch (settings.key_mode) {
-        case KeyMode::error: enc.channels[c] = fitters[c].fit(tol[c], step, round ? &changed[c] : nullptr); break;
-        case KeyMode::curvature: enc.channels[c] = fit_channel_at_keys(sig[c], curvature_keys(sig[c]), tol[c], step, fit_opt); break;
-        default: enc.channels[c] = fit_channel_at_keys(sig[c], fixed_keys, tol[c], step, fit_opt); break;
+    for (uint32_t c = 0; c < n_ch; ++c)
+      if (dirty[c]) refit.push_back(c), dirty[c] = false;
+    // Channels are fitted independently: spread them over threads (the result does not depend
+    // on how).
+    std::atomic<size_t> next{0};
+    auto fit_some = [&] {
+      for (size_t i; (i = next.fetch_add(1)) < refit.size();) {
+        const uint32_t c = refit[i];
+        // The step halves (rather than follows the smallest tolerance) so that tightening a few
+        // frames rarely requantizes the whole channel.
+        const double min_tol = n_fr ? *std::min_element(tol[c].begin(), tol[c].end()) : base_tol[c];
+        double step = kStepFraction * base_tol[c];
+        while (step > kStepFraction * min_tol) step *= 0.5;
+        switch (settings.key_mode) {
+          case KeyMode::error: enc.channels[c] = fitters[c].fit(tol[c], step, round ? &changed[c] : nullptr); break;
+          case KeyMode::curvature: enc.channels[c] = fit_channel_at_keys(sig[c], curvature_keys(sig[c]), tol[c], step, fit_opt); break;
+          default: enc.channels[c] = fit_channel_at_keys(sig[c], fixed_keys, tol[c], step, fit_opt); break;
+        }
       }
-    }
+    };
+    std::vector<std::thread> pool;
+    for (uint32_t t = 1; t < std::min<size_t>(threads, refit.size()); ++t) pool.emplace_back(fit_some);
+    fit_some();
+    for (std::thread& t : pool) t.join();
     if (settings.key_mode != KeyMode::error || n_fr == 0) break;
 
     // Verify by FK on what the decoder produces, on the frames whose values changed (and those

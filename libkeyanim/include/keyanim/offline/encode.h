@@ -30,6 +30,7 @@ struct EncodeSettings {
   bool allow_linear = true;                // Defaults to true: a channel may pick linear if cheaper.
   bool force_linear = false;               // Defaults to false. True: every channel linear (comparisons).
   int zstd_level = 19;                     // Defaults to 19 (1..22).
+  uint32_t threads = 1;                    // Defaults to 1; 0: one per core. Output is the same.
 
   // Empty if valid, else what is wrong.
   std::string validate() const;
