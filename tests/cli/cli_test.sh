@@ -32,7 +32,8 @@ json)
   size=$(stat -c %s w.kanim)
   [ "$(json 'd["kanim_bytes"]' <enc.json)" = "$size" ] || die "encode --json kanim_bytes is not the file size"
   [ "$(json 'd["error"]["max"] <= d["tolerance"]' <enc.json)" = "True" ] || die "encode reports an error over tolerance"
-  "$K" eval "$WALK" --error 0.05% --json >eval.json || die "eval --json"
+  "$K" eval "$WALK" --error 0.05%,0.5% --json >eval.json || die "eval --json"
+  [ "$(json 'len(d["files"][0]["results"])' <eval.json)" = "2" ] || die "eval did not run both tolerances"
   [ "$(json 'd["files"][0]["results"][0]["kanim_bytes"]' <eval.json)" = "$size" ] || die "eval bytes differ from encode"
   [ "$(json 'd["files"][0]["frames"]' <eval.json)" = "344" ] || die "eval frames"
   "$K" info w.kanim --json | json 'd["keys"]["total"]' >keys || die "info --json"

@@ -99,7 +99,7 @@ int cmd_eval(const Argv& argv, Globals& g) {
   }
   std::vector<offline::EncodeSettings> runs;
   for (const std::string& label : labels) {
-    offline::EncodeSettings s = encode_settings(args);  // --keys, --tension, --level
+    offline::EncodeSettings s = encode_settings(args, false);  // --keys, --tension, --level
     parse_tolerance(label, s);
     if (const std::string why = s.validate(); !why.empty()) fail(kUsage, why);
     runs.push_back(s);

@@ -46,9 +46,9 @@ void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
   }
 }
 
-offline::EncodeSettings encode_settings(const Args& args) {
+offline::EncodeSettings encode_settings(const Args& args, bool read_error) {
   offline::EncodeSettings s;
-  if (auto e = args.get("--error")) parse_tolerance(*e, s);
+  if (auto e = args.get("--error"); e && read_error) parse_tolerance(*e, s);
   if (auto k = args.get("--keys")) parse_key_mode(*k, s);
   if (auto t = args.get("--tension")) {
     if (*t == "fit") {
