@@ -224,13 +224,41 @@ def parse(data):
     if not r.at_end():
         raise KanimError("corrupt", "KTIM size")
 
-    # KVAL
-    r = Reader(content["KVAL"], "KVAL")
+    # KVAL: Plane_Count, Plane_Size[], planes; byte k of each varint comes from plane k.
+    kval = content["KVAL"]
+    if len(kval) < 1 or kval[0] > 10:
+        raise KanimError("corrupt", "Plane_Count")
+    P = kval[0]
+    if (P == 0) != (K == 0) or len(kval) < 1 + 4 * P:
+        raise KanimError("corrupt", "KVAL planes")
+    sizes = list(struct.unpack_from(f"<{P}I", kval, 1))
+    if 1 + 4 * P + sum(sizes) != len(kval) or 0 in sizes or (P and sizes[0] != K):
+        raise KanimError("corrupt", "KVAL plane sizes")
+    planes, at = [], 1 + 4 * P
+    for size in sizes:
+        planes.append(Reader(kval[at:at + size], "KVAL plane"))
+        at += size
+
+    def plane_varint():
+        value = 0
+        for k in range(10):
+            if k >= P:
+                raise KanimError("corrupt", "varint past the last plane")
+            b = planes[k].take(1)[0]
+            value |= (b & 0x7F) << (7 * k)
+            if not b & 0x80:
+                if b == 0 and k > 0:
+                    raise KanimError("corrupt", "over-long varint")
+                if value >> 64:
+                    raise KanimError("corrupt", "varint too large")
+                return value
+        raise KanimError("corrupt", "varint too long")
+
     values = []
     for c in range(C):
         q, vals = 0, []
         for _ in range(key_count[c]):
-            u = r.varint(10, 64)
+            u = plane_varint()
             q += (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
             if abs(q) > 2 ** 53:
                 raise KanimError("corrupt", f"channel {c} |q|")
@@ -239,8 +267,8 @@ def parse(data):
                 raise KanimError("corrupt", f"channel {c} value")
             vals.append(v)
         values.append(vals)
-    if not r.at_end():
-        raise KanimError("corrupt", "KVAL size")
+    if not all(p.at_end() for p in planes):
+        raise KanimError("corrupt", "KVAL plane bytes left over")
 
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": interp, "tension": tension, "frames": frames, "values": values,

@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -598,6 +599,18 @@ TEST_CASE("the cursor never changes a result") {
   }
   CHECK(mismatches == 0);
   CHECK(cursor.clip == &clip);
+
+  // A new clip at the address of a destroyed one is still a different clip for the cursor.
+  std::optional<Clip> slot;
+  slot.emplace(keyanim::offline::to_clip(random_clip(21, 300, 4)));
+  std::vector<float> x(slot->channel_count()), y(slot->channel_count());
+  keyanim::SampleCursor reused;
+  REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
+  slot.emplace(keyanim::offline::to_clip(random_clip(22, 300, 4)));
+  REQUIRE(slot->channel_count() == x.size());
+  REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
+  REQUIRE(slot->sample(150.5, y) == Status::ok);
+  for (size_t c = 0; c < x.size(); ++c) CHECK(same_bits(x[c], y[c]));
 }
 
 TEST_CASE("sample_time sample_channels and argument errors") {
@@ -630,13 +643,13 @@ TEST_CASE("sample_time sample_channels and argument errors") {
   CHECK(single.duration() == 0.0);
 }
 
-TEST_CASE("memory stays within twice the key arrays plus the tracks and skeleton") {
+TEST_CASE("memory stays within 1.5 times the key arrays plus the tracks and skeleton") {
   for (uint64_t seed : {11u, 12u, 13u}) {
     const Clip clip = keyanim::offline::to_clip(random_clip(seed, 2000, 12));
     const size_t keys = clip.total_keys() * 8;
     const size_t fixed = sizeof(Clip) + clip.channel_count() * sizeof(keyanim::ChannelTrack) +
                          clip.skeleton().joints.size() * (sizeof(Joint) + 64);
-    CHECK(clip.memory_bytes() <= 2 * keys + fixed);
+    CHECK(clip.memory_bytes() <= keys + keys / 2 + fixed);  // the index is at most half the keys
     CHECK(clip.memory_bytes() >= keys);
   }
 }
@@ -983,30 +996,78 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
     r.get("KTIM").stored.push_back(0);
     CHECK_FAILS(r.build(), Status::corrupt, ktim + base.sections[3].stored.size());
   }
-  const size_t kval = base.offset_of("KVAL");
-  {
-    // First delta of channel 0 made 2^53 + 1 (zigzag 2^54 + 2): |q| > 2^53.
-    RawFile r = base;
-    auto& s = r.get("KVAL").stored;
-    size_t first_len = 1;
-    while (s[first_len - 1] & 0x80) ++first_len;
-    s.erase(s.begin(), s.begin() + long(first_len));
+  // KVAL, rebuilt here from the quantized values of vector_uniform by the spec's text:
+  // zigzag deltas as LEB128 varints, byte k of each varint in plane k.
+  auto varint = [](uint64_t x) {
     std::vector<uint8_t> v;
-    for (uint64_t x = (uint64_t(1) << 54) + 2; ; x >>= 7) {
+    for (;; x >>= 7) {
       v.push_back(uint8_t((x & 0x7F) | (x >= 0x80 ? 0x80 : 0)));
-      if (x < 0x80) break;
+      if (x < 0x80) return v;
     }
-    s.insert(s.begin(), v.begin(), v.end());
-    CHECK_FAILS(r.build(), Status::corrupt, kval);
+  };
+  auto zigzag = [](int64_t d) { return d >= 0 ? uint64_t(d) * 2 : uint64_t(-(d + 1)) * 2 + 1; };
+  std::vector<std::vector<uint8_t>> varints;
+  for (const auto& ch : vector_uniform().channels)
+    for (size_t i = 0; i < ch.q.size(); ++i) varints.push_back(varint(zigzag(ch.q[i] - (i ? ch.q[i - 1] : 0))));
+  auto planes = [](const std::vector<std::vector<uint8_t>>& vs) {
+    std::vector<std::vector<uint8_t>> pl;
+    for (const auto& v : vs)
+      for (size_t k = 0; k < v.size(); ++k) {
+        if (pl.size() <= k) pl.emplace_back();
+        pl[k].push_back(v[k]);
+      }
+    std::vector<uint8_t> out = {uint8_t(pl.size())};
+    for (const auto& p : pl) put(out, uint32_t(p.size()));
+    for (const auto& p : pl) out.insert(out.end(), p.begin(), p.end());
+    return out;
+  };
+  REQUIRE(planes(varints) == base.sections[4].stored);  // the writer follows the text
+  const size_t kval = base.offset_of("KVAL");
+  const size_t first_byte = kval + 1 + 4 * 3;  // three planes: the largest zigzag is 36000
+  auto with_varints = [&](const std::vector<std::vector<uint8_t>>& vs) {
+    RawFile r = base;
+    r.get("KVAL").stored = planes(vs);
+    return r.build();
+  };
+  {
+    // First delta of channel 0 made 2^53 + 1: |q| > 2^53 (eight planes now).
+    auto vs = varints;
+    vs[0] = varint(zigzag((int64_t(1) << 53) + 1));
+    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 8);
+    vs[0] = varint(zigzag((int64_t(1) << 53)));
+    vs[1] = varint(zigzag(1));  // 2^53 + 1 in the second key
+    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 8 + 1);
+  }
+  {
+    auto vs = varints;
+    vs[0] = {0x81, 0x00};  // 1, over-long
+    CHECK_FAILS(with_varints(vs), Status::corrupt, first_byte);
   }
   {
     RawFile r = base;
     r.get("KVAL").stored.push_back(0);
-    CHECK_FAILS(r.build(), Status::corrupt, kval + base.sections[4].stored.size());
+    CHECK_FAILS(r.build(), Status::corrupt, kval + 1);  // plane sizes do not add up
+    r.get("KVAL").stored = base.sections[4].stored;
+    r.get("KVAL").stored[0] = 11;
+    CHECK_FAILS(r.build(), Status::corrupt, kval);
+    r.get("KVAL").stored = {0};  // no planes for 18 keys
+    CHECK_FAILS(r.build(), Status::corrupt, kval);
+  }
+  {
+    // Plane 0 one byte short, plane 1 one longer: sizes add up, plane 0 does not match K.
+    auto v = base.sections[4].stored;
+    uint32_t p0 = 0, p1 = 0;
+    std::memcpy(&p0, &v[1], 4);
+    std::memcpy(&p1, &v[5], 4);
+    poke(v, 1, p0 - 1);
+    poke(v, 5, p1 + 1);
+    RawFile r = base;
+    r.get("KVAL").stored = v;
+    CHECK_FAILS(r.build(), Status::corrupt, kval + 1);
   }
   {
     // A step so large that a value overflows binary32.
-    CHECK_FAILS(with("CHAN", 5 * C + 8 * 0, 1e300), Status::corrupt, kval);
+    CHECK_FAILS(with("CHAN", 5 * C + 8 * 0, 1e300), Status::corrupt, first_byte);
   }
 }
 

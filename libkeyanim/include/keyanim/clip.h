@@ -36,6 +36,12 @@ struct ChannelTrack {
 struct SampleCursor {
   const void* clip = nullptr;
   std::vector<uint32_t> segment;  // per channel
+  // Private to Clip: the identity of the clip the state below belongs to, and each channel's
+  // current segment, prepared (its range of validity and Hermite operands) so that a frame
+  // within the same segments costs only the polynomial.
+  uint64_t clip_id = 0;
+  std::vector<float> cache;
+  std::vector<uint32_t> flags;
 };
 
 class Clip {
@@ -68,7 +74,7 @@ class Clip {
   // Informative encoder notes stored in the file (settings, measured error), as key=value text.
   const std::string& encoder_notes() const noexcept { return notes_; }
   // Bytes held by this object (key arrays, tracks, skeleton, notes, the segment index), for
-  // memory budgets. The segment index is never larger than the key arrays.
+  // memory budgets. The segment index is never larger than half the key arrays.
   size_t memory_bytes() const noexcept;
 
   // Every channel at frame position f (fractional frames are in-betweens; clamped to the clip),
@@ -106,8 +112,10 @@ class Clip {
   // The index row for position f, or null when there is no index.
   const uint32_t* index_row(float f) const noexcept;
   // Channels channels[0..count) (or 0..count when `channels` is null) at f into out.
-  void sample_batch(float f, const uint32_t* channels, uint32_t count, float* out,
-                    uint32_t* cursor_segments) const noexcept;
+  void sample_batch(float f, const uint32_t* channels, uint32_t count, float* out) const noexcept;
+  // All channels through a prepared cursor (sequential playback).
+  void sample_cursor(float f, float* out, SampleCursor& cursor) const noexcept;
+  void refresh_cursor(uint32_t c, float f, SampleCursor& cursor) const noexcept;
 
   uint16_t version_major_ = 0, version_minor_ = 0;
   uint32_t frame_count_ = 0;
@@ -124,6 +132,9 @@ class Clip {
   std::vector<uint32_t> index_;
   uint32_t index_shift_ = 0;
   uint32_t index_buckets_ = 0;
+  // Distinguishes clips for cursors (an address can be reused by another clip); copies share it,
+  // as they share the content.
+  uint64_t id_ = 0;
 };
 
 }  // namespace keyanim

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -85,14 +86,34 @@ std::vector<uint8_t> ktim_section(const std::vector<EncodedChannel>& chans) {
   return s;
 }
 
+// The value varints split into byte planes: plane k holds the k-th byte of every varint that
+// has one. First bytes (mostly small deltas), and the rarer high bytes, then each form a
+// stream of like statistics, which zstd codes 5-9 % smaller than the varints in sequence.
 std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans) {
-  std::vector<uint8_t> s;
+  std::vector<uint8_t> planes[internal::kMaxVarint64Bytes];
+  std::vector<uint8_t> one;
   for (const auto& c : chans) {
     int64_t prev = 0;
     for (int64_t q : c.q) {
-      put_varint(s, internal::zigzag_encode(q - prev));  // |q| <= 2^53: no overflow
+      one.clear();
+      put_varint(one, internal::zigzag_encode(q - prev));  // |q| <= 2^53: no overflow
+      for (size_t k = 0; k < one.size(); ++k) planes[k].push_back(one[k]);
       prev = q;
     }
+  }
+  uint8_t count = 0;
+  while (count < internal::kMaxVarint64Bytes && !planes[count].empty()) ++count;
+  std::vector<uint8_t> s(1, count);  // Plane_Count
+  size_t total = s.size();
+  for (uint8_t k = 0; k < count; ++k) {
+    put_le<uint32_t>(s, static_cast<uint32_t>(planes[k].size()));
+    total += 4 + planes[k].size();
+  }
+  s.resize(total);  // then copy: GCC 12 warns falsely (-Wstringop-overflow) on inserts here
+  size_t at = 1 + 4 * size_t(count);
+  for (uint8_t k = 0; k < count; ++k) {
+    if (!planes[k].empty()) std::memcpy(s.data() + at, planes[k].data(), planes[k].size());
+    at += planes[k].size();
   }
   return s;
 }
@@ -104,20 +125,38 @@ struct Section {
   std::vector<uint8_t> stored;
 };
 
-Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, int level) {
+// Compresses `raw` as one zstd frame, ending a zstd block at each of `breaks` (offsets) so
+// that streams of different statistics (the KVAL planes) get their own entropy tables.
+Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, int level,
+                     const std::vector<size_t>& breaks = {}) {
   Section sec;
   sec.tag = tag;
   sec.flags = flags;
   sec.raw_size = raw.size();
   if (!raw.empty() && cctx != nullptr) {
-    std::vector<uint8_t> z(ZSTD_compressBound(raw.size()));
+    std::vector<uint8_t> z(ZSTD_compressBound(raw.size()) + 64 * (breaks.size() + 1));
     ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);  // the spec requires it
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);     // the file has its own CRC
-    const size_t n = ZSTD_compress2(cctx, z.data(), z.size(), raw.data(), raw.size());
-    if (!ZSTD_isError(n) && n < raw.size()) {
-      z.resize(n);
+    ZSTD_CCtx_setPledgedSrcSize(cctx, raw.size());
+    ZSTD_outBuffer out{z.data(), z.size(), 0};
+    bool ok = true;
+    size_t from = 0;
+    for (size_t k = 0; k <= breaks.size() && ok; ++k) {
+      const size_t to = k < breaks.size() ? std::min(breaks[k], raw.size()) : raw.size();
+      if (to < from) continue;
+      ZSTD_inBuffer in{raw.data() + from, to - from, 0};
+      const ZSTD_EndDirective mode = k < breaks.size() ? ZSTD_e_flush : ZSTD_e_end;
+      size_t left = 0;
+      do {
+        left = ZSTD_compressStream2(cctx, &out, &in, mode);
+        if (ZSTD_isError(left) || (left != 0 && out.pos == out.size)) ok = false;
+      } while (ok && left != 0);
+      from = to;
+    }
+    if (ok && out.pos < raw.size()) {
+      z.resize(out.pos);
       sec.stored = std::move(z);
       sec.flags |= internal::kSectionCompressed;
       return sec;
@@ -125,6 +164,20 @@ Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZST
   }
   sec.stored = std::move(raw);
   return sec;
+}
+
+// Plane boundaries of a KVAL section (after the header, and after every plane but the last).
+std::vector<size_t> kval_breaks(const std::vector<uint8_t>& kval) {
+  std::vector<size_t> breaks;
+  const size_t count = kval.empty() ? 0 : kval[0];
+  size_t at = 1 + 4 * count;
+  for (size_t k = 0; k + 1 < count; ++k) {
+    uint32_t n = 0;
+    std::memcpy(&n, kval.data() + 1 + 4 * k, 4);  // written just above by this file
+    at += internal::load_le<uint32_t>(reinterpret_cast<const uint8_t*>(&n));
+    breaks.push_back(at);
+  }
+  return breaks;
 }
 
 uint32_t crc32_of(const uint8_t* p, size_t n) {
@@ -189,7 +242,14 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
   sections.push_back(make_section(internal::kTagSkel, 0, skel_section(clip.skeleton), cctx, level));
   sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels), cctx, level));
   sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
-  sections.push_back(make_section(internal::kTagKval, 0, kval_section(clip.channels), cctx, level));
+  {
+    // With and without block breaks at the planes: the breaks usually win (by 0-7 %), not always.
+    std::vector<uint8_t> kval = kval_section(clip.channels);
+    const std::vector<size_t> breaks = kval_breaks(kval);
+    Section split = make_section(internal::kTagKval, 0, kval, cctx, level, breaks);
+    Section whole = make_section(internal::kTagKval, 0, std::move(kval), cctx, level);
+    sections.push_back(split.stored.size() <= whole.stored.size() ? std::move(split) : std::move(whole));
+  }
   if (!clip.notes.empty()) {
     std::vector<uint8_t> text(clip.notes.begin(), clip.notes.end());
     sections.push_back(make_section(internal::kTagNote, internal::kSectionAncillary, std::move(text), cctx, level));

@@ -11,6 +11,7 @@
 // division, never accumulated.
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "keyanim/offline/decode.h"

@@ -4,6 +4,7 @@
 #include <zlib.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -408,8 +409,12 @@ Status Loader::parse_ktim(const Content& c, Clip::Parts& parts) {
     for (uint32_t i = 0; i < t.key_count; ++i) {
       const size_t at = pos;
       uint64_t v = 0;
-      const auto e = internal::get_varint(c.data, c.size, pos, internal::kMaxVarint32Bytes, v);
-      if (e != internal::VarintError::none) return fail_in(Status::corrupt, c, at, varint_problem(e));
+      if (pos < c.size && c.data[pos] < 0x80) {
+        v = c.data[pos++];  // the usual one-byte gap
+      } else {
+        const auto e = internal::get_varint(c.data, c.size, pos, internal::kMaxVarint32Bytes, v);
+        if (e != internal::VarintError::none) return fail_in(Status::corrupt, c, at, varint_problem(e));
+      }
       frame = i == 0 ? v : frame + v + 1;  // < 2^33: no overflow
       if (frame >= frames)
         return fail_in(Status::corrupt, c, at,
@@ -422,32 +427,77 @@ Status Loader::parse_ktim(const Content& c, Clip::Parts& parts) {
 }
 
 Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
-  if (key_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KVAL is too short for Key_Count varints");
-  parts.key_values.resize(static_cast<size_t>(key_count_));
+  // Plane_Count, Plane_Size[Plane_Count], then the planes (spec/FORMAT.md 4.5).
+  ByteReader r(c.data, c.size);
+  uint8_t count = 0;
+  if (!r.read(count) || count > internal::kMaxVarint64Bytes)
+    return fail_in(Status::corrupt, c, 0, "Plane_Count must be 0 to 10");
+  if ((count == 0) != (key_count_ == 0))
+    return fail_in(Status::corrupt, c, 0, "Plane_Count must be 0 exactly when there are no keys");
+  const uint8_t* plane[internal::kMaxVarint64Bytes] = {};
+  uint64_t size[internal::kMaxVarint64Bytes] = {};
+  size_t base[internal::kMaxVarint64Bytes] = {};  // section offsets, for errors
+  uint64_t total = 1 + 4 * uint64_t(count);
+  if (c.size < total) return fail_in(Status::corrupt, c, 0, "KVAL ends inside its plane sizes");
+  for (uint8_t k = 0; k < count; ++k) {
+    uint32_t n = 0;
+    r.read(n);
+    size[k] = n;
+    total += n;
+    if (n == 0) return fail_in(Status::corrupt, c, 1 + 4 * size_t(k), "an empty plane");
+  }
+  if (total != c.size) return fail_in(Status::corrupt, c, 1, "the plane sizes do not add up to Raw_Size");
+  if (count > 0 && size[0] != key_count_)
+    return fail_in(Status::corrupt, c, 1, "plane 0 must hold one byte per key");
+  size_t at = 1 + 4 * size_t(count);
+  for (uint8_t k = 0; k < count; ++k) {
+    base[k] = at;
+    plane[k] = c.data + at;
+    at += static_cast<size_t>(size[k]);
+  }
+  parts.key_values.resize(static_cast<size_t>(key_count_));  // key_count_ == size[0] <= c.size
   float* out = parts.key_values.data();
-  size_t pos = 0;
+  size_t pos[internal::kMaxVarint64Bytes] = {};
   for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
     const ChannelTrack& t = parts.tracks[ch];
     const double step = steps_[ch];
     int64_t q = 0;
     for (uint32_t i = 0; i < t.key_count; ++i) {
-      const size_t at = pos;
-      uint64_t v = 0;
-      const auto e = internal::get_varint(c.data, c.size, pos, internal::kMaxVarint64Bytes, v);
-      if (e != internal::VarintError::none) return fail_in(Status::corrupt, c, at, varint_problem(e));
+      const size_t first_at = base[0] + pos[0];
+      // The varint's k-th byte is the next unread byte of plane k (section 6.1 rules). Plane 0
+      // holds exactly one byte per key, so its first byte is always there.
+      uint64_t v = plane[0][pos[0]++];
+      if (v & 0x80u) {
+        v &= 0x7Fu;
+        for (uint32_t k = 1;; ++k) {
+          if (k >= count || pos[k] == size[k])
+            return fail_in(Status::corrupt, c, k < count ? base[k] + pos[k] : first_at,
+                           "a varint continues past the bytes of its planes");
+          const uint8_t b = plane[k][pos[k]++];
+          const uint64_t bits = b & 0x7Fu;
+          if (k == internal::kMaxVarint64Bytes - 1 && ((b & 0x80u) || bits > 1))
+            return fail_in(Status::corrupt, c, first_at, "a varint too large for its field");
+          v |= bits << (7 * k);
+          if (!(b & 0x80u)) {
+            if (b == 0) return fail_in(Status::corrupt, c, first_at, "an over-long varint");
+            break;
+          }
+        }
+      }
       // zigzag: |d| = (v + 1) / 2 without overflow.
       if ((v >> 1) + (v & 1) > internal::kMaxAbsDelta)
-        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": a delta beyond 2^54");
+        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": a delta beyond 2^54");
       q += internal::zigzag_decode(v);
       if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ)
-        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": |q| > 2^53");
+        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": |q| > 2^53");
       const float value = dequantize(q, step);
       if (!std::isfinite(value))
-        return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": a key value is not finite");
+        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": a key value is not finite");
       out[t.first_key + i] = value;
     }
   }
-  if (pos != c.size) return fail_in(Status::corrupt, c, pos, "bytes after the last key value");
+  for (uint8_t k = 0; k < count; ++k)
+    if (pos[k] != size[k]) return fail_in(Status::corrupt, c, base[k] + pos[k], "plane bytes left over");
   return Status::ok;
 }
 
@@ -456,10 +506,6 @@ Status Loader::run(Clip::Parts& parts) {
   if (s != Status::ok) return s;
   parts.version_major = 1;
   parts.version_minor = minor_;
-  static const char* const kNames[5] = {"CLIP", "SKEL", "CHAN", "KTIM", "KVAL"};
-  using Parser = Status (Loader::*)(const Content&, Clip::Parts&);
-  static const Parser kParsers[5] = {&Loader::parse_clip, &Loader::parse_skel, &Loader::parse_chan,
-                                     &Loader::parse_ktim, &Loader::parse_kval};
   // Sections in table order (the critical ones are in order by now); unknown ancillary
   // sections are skipped without being decompressed.
   for (size_t i = 0; i < table_.size(); ++i) {
@@ -469,10 +515,16 @@ Status Loader::run(Clip::Parts& parts) {
       if ((s = get_content(e, "NOTE", c)) != Status::ok) return s;
       parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);
     } else {
-      for (size_t k = 0; k < 5; ++k) {
+      for (int k = 0; k < 5; ++k) {
         if (critical_index_[k] != static_cast<int>(i)) continue;
-        if ((s = get_content(e, kNames[k], c)) != Status::ok) return s;
-        if ((s = (this->*kParsers[k])(c, parts)) != Status::ok) return s;
+        switch (k) {
+          case 0: s = get_content(e, "CLIP", c); if (s == Status::ok) s = parse_clip(c, parts); break;
+          case 1: s = get_content(e, "SKEL", c); if (s == Status::ok) s = parse_skel(c, parts); break;
+          case 2: s = get_content(e, "CHAN", c); if (s == Status::ok) s = parse_chan(c, parts); break;
+          case 3: s = get_content(e, "KTIM", c); if (s == Status::ok) s = parse_ktim(c, parts); break;
+          default: s = get_content(e, "KVAL", c); if (s == Status::ok) s = parse_kval(c, parts); break;
+        }
+        if (s != Status::ok) return s;
       }
     }
     buffers_.clear();  // a decompressed section is not needed once parsed

@@ -16,8 +16,16 @@ struct ResampleOptions {
   uint32_t last_frame = UINT32_MAX;    // Defaults to the last frame (inclusive).
 };
 
-// Fails (returns false) only for options that make no sense (fps <= 0 but non-zero, both fps and
-// inbetweens, an empty or reversed range); `error` says why.
+// Output frame i lies at source frame position
+//   source rate:   first + i                           (last - first + 1 frames)
+//   inbetweens N:  first + i / (N + 1)                 ((last - first) (N + 1) + 1 frames)
+//   fps:           first + (i / fps) / frame_time      (floor(D fps + 1e-6) + 1 frames)
+// with D = (last - first) frame_time seconds: frames every 1/fps s from the range's start up
+// to its end, the end included when it lands on an output frame (within 1e-6 of one).
+// Values are the clip's float samples as doubles; frame_time becomes frame_time / (N + 1) or
+// 1 / fps. A clip without frames decodes to an empty motion.
+// Fails (returns false) only for options that make no sense (fps < 0 or not finite, both fps
+// and inbetweens, an empty or reversed range, last_frame beyond the clip); `error` says why.
 bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error);
 
 }  // namespace keyanim::offline
