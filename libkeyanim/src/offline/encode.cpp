@@ -31,9 +31,11 @@ constexpr double kInitialShare = 1.0;
 // Rotation error of a joint with nothing measurable below it is budgeted as if a point sat this
 // far from it (fraction of the skeleton size; ACL uses a 3 cm shell, about 2% of a human).
 constexpr double kShellFraction = 0.02;
-// Quantization step as a fraction of the channel's smallest per-frame tolerance. Errors are
-// checked after quantization, so a coarse step costs only a few extra keys.
-constexpr double kStepFraction = 1.0;
+// Quantization step as a fraction of the channel's smallest per-frame tolerance (a key is then
+// off by at most 0.75 of it). Errors are checked after quantization, so a coarse step costs
+// only a few extra keys; measured on four CMU clips, 1.5 is 2.8% smaller than 1.0 at 0.05% of
+// the skeleton size (1.25: 0.6%, 1.75: 2.4%, 2.0: 1.8%).
+constexpr double kStepFraction = 1.5;
 // Tightening overshoots the needed ratio slightly so that few rounds are needed (0.8 saves
 // a third of the rounds but costs 5-8% more bytes on CMU clips).
 constexpr double kTightenMargin = 0.9;
