@@ -59,8 +59,8 @@ TEST_SUITE("corpus") {
       CHECK(back.frame_time == m.frame_time);
       const ErrorReport e = measure_error(m, back);
       CHECK(e.max_error <= r.tolerance_units);
-      if (skeleton_size(m.skeleton) > 0.0)  // a lone root falls back to the extent of its path
-        CHECK(r.tolerance_units == doctest::Approx(0.0005 * skeleton_size(m.skeleton)));
+      CHECK(r.tolerance_units == doctest::Approx(0.0005 * reference_size(m)));
+      if (skeleton_size(m.skeleton) > 0.0) CHECK(reference_size(m) == skeleton_size(m.skeleton));
     }
   }
 }

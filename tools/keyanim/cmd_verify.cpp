@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "keyanim/offline/decode.h"
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
 #include "report.h"
@@ -48,7 +49,7 @@ int cmd_verify(const Argv& argv, Globals& g) {
       if (auto limit = args.get("--max-error")) {
         offline::EncodeSettings s;
         parse_tolerance(*limit, s);
-        const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::skeleton_size(orig.skeleton) : s.tolerance;
+        const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::reference_size(orig) : s.tolerance;
         j["max_error_allowed"] = units;
         if (!(e.max_error <= units)) {
           ok = false;

@@ -130,6 +130,19 @@ std::string describe(const EncodeSettings& s, double tol_units, const ErrorRepor
 
 }  // namespace
 
+double reference_size(const Motion& m) {
+  const double size = skeleton_size(m.skeleton);
+  if (size > 0.0) return size;
+  Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  std::vector<Vec3> pos;
+  for (uint32_t f = 0; f < m.frame_count; ++f) {
+    world_positions(m.skeleton, m.frame(f), pos);
+    for (const Vec3& p : pos)
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  }
+  return m.frame_count ? std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}) : 0.0;
+}
+
 std::string EncodeSettings::validate() const {
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return "tolerance must be a positive number";
   if (tolerance_in_percent && tolerance > 100.0) return "tolerance in percent must be at most 100";
@@ -158,15 +171,9 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   }
 
   // Tolerance in file units. A skeleton with no extent (a lone root) falls back to its path.
-  double size = skeleton_size(m.skeleton);
   const std::vector<Vec3> orig_pos = world_positions_all(m);
   const size_t n_nodes = m.skeleton.joints.size();
-  if (!(size > 0.0)) {
-    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-    for (const Vec3& p : orig_pos)
-      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-    size = orig_pos.empty() ? 0.0 : std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  }
+  const double size = reference_size(m);
   const double tol_units = settings.tolerance_in_percent ? settings.tolerance / 100.0 * size : settings.tolerance;
   if (!(tol_units > 0.0)) {
     error = "the skeleton has no extent, so a tolerance in percent means nothing: give it in file units";

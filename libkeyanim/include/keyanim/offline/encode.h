@@ -65,6 +65,10 @@ struct EncodeResult {
 // Returns false with `error` set for invalid settings or a motion the codec cannot take.
 bool encode(const Motion& motion, const EncodeSettings& settings, EncodeResult& out, std::string& error);
 
+// What a tolerance in percent is a percent of: the skeleton size (fk.h), or for a skeleton with
+// no extent (a lone root) the largest side of the box its nodes sweep over the clip.
+double reference_size(const Motion& motion);
+
 // Unwraps a rotation channel in place so that no step exceeds 180 degrees.
 void unwrap_degrees(std::vector<double>& signal);
 
