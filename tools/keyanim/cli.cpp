@@ -50,6 +50,18 @@ extern "C" void remove_temps_and_die(int sig) {
   std::raise(sig);
 }
 
+// Writes everything, retrying short writes; 0 or the errno that stopped it.
+int write_all(int fd, const std::string& data) {
+  size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n < 0 ? errno : EIO;
+    done += size_t(n);
+  }
+  return 0;
+}
+
 }  // namespace
 
 void install_interrupt_cleanup() {
@@ -201,6 +213,15 @@ void write_output(const std::string& path, const std::string& data, bool binary,
   std::error_code ec;
   if (fs::exists(path, ec) && !g.force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
   if (fs::is_directory(path, ec)) fail(kOutputFailed, path + ": is a directory");
+  // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
+  if (const auto st = fs::status(path, ec); fs::exists(st) && !fs::is_regular_file(st)) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
+    int err = write_all(fd, data);
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) fail(kOutputFailed, path + ": cannot write: " + std::strerror(err));
+    return;
+  }
   // A temporary file beside the target, renamed over it only once complete.
   fs::path target(path);
   std::string tmpl = (target.has_parent_path() ? target.parent_path() / "" : fs::path()).string() + "." +
@@ -211,13 +232,7 @@ void write_output(const std::string& path, const std::string& data, bool binary,
   if (fd < 0) fail(kOutputFailed, path + ": cannot create a file in its directory: " + std::strerror(errno));
   const std::string tmp(name.data());
   const int slot = register_temp(tmp);
-  size_t done = 0;
-  int err = 0;  // first errno seen
-  while (err == 0 && done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) err = n < 0 ? errno : EIO; else done += size_t(n);
-  }
+  int err = write_all(fd, data);  // first errno seen
   if (err == 0 && ::fsync(fd) != 0) err = errno;
   if (::close(fd) != 0 && err == 0) err = errno;
   if (err == 0) {  // mkstemp makes 0600; give the file the usual permissions

@@ -36,6 +36,7 @@ nlohmann::json encode_one(const std::string& in, const std::string& out, const o
   std::string error;
   if (!offline::encode(motion, settings, result, error)) fail(kBadInput, in + ": " + error);
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level);
+  if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   write_output(out, std::string(bytes.begin(), bytes.end()), true, g);
   const double raw = 4.0 * motion.frame_count * motion.channel_count();
