@@ -7,4 +7,8 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
   g++ cmake make pkg-config libzstd-dev zlib1g-dev nlohmann-json3-dev doctest-dev >/dev/null
+# For scripts/sanitize.sh's fuzz step: clang with libFuzzer (optional; skipped if unavailable).
+$SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null 2>&1 ||
+  $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >/dev/null 2>&1 ||
+  echo "keyanim: clang/libFuzzer not installed; the fuzz step of scripts/sanitize.sh will be skipped"
 echo "keyanim: build dependencies installed"

@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""Regenerates the seed files of fuzz/corpus/ (the committed ones were made by this script).
+
+usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
+
+ - bvh/:       tests/data/bvh fixtures, data/*.bvh and CMU clips of the shared corpus cut to 3 frames
+ - roundtrip/: a settings byte + BVH snippets of at most 2000 values (see fuzz_roundtrip.cpp)
+ - load/:      spec/test-vectors/*.kanim and .kanim files encoded (by KEYANIM_BINARY) from snippets,
+               each also with its sections stored uncompressed (zstd CLI)
+ - sample/:    request records + those .kanim files (see fuzz_sample.cpp)
+
+Only CMU clips are used from the shared corpus (their terms allow it); never bandai/ or ManipNet.
+Crash inputs found later are added by hand as crash-<what>.* files and never regenerated.
+"""
+import os
+import random
+import re
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+def cut_bvh(data: bytes, frames: int) -> bytes:
+    """The header of a BVH file and its first `frames` motion lines, line endings kept."""
+    lines = data.splitlines(keepends=True)
+    out, i = [], 0
+    while i < len(lines) and not lines[i].strip().upper().startswith(b"MOTION"):
+        out.append(lines[i])
+        i += 1
+    out.append(lines[i])  # MOTION
+    i += 1
+    m = re.match(rb"(\s*Frames:\s*)\d+(.*)", lines[i], re.S)
+    out.append(m.group(1) + str(frames).encode() + m.group(2))
+    out.append(lines[i + 1])  # Frame Time
+    out.extend(lines[i + 2:i + 2 + frames])
+    return b"".join(out)
+
+
+def channels_of(bvh: bytes) -> int:
+    return sum(int(m.group(1)) for m in re.finditer(rb"CHANNELS\s+(\d+)", bvh))
+
+
+def uncompressed(kanim: bytes) -> bytes:
+    """The same .kanim with every zstd section stored raw (zstd CLI), so that mutations of the
+    seed reach the section parsers' fields directly; the CRC-32 is recomputed."""
+    count = struct.unpack_from("<I", kanim, 16)[0]
+    table, sections, pos = [], [], 24 + 24 * count
+    for i in range(count):
+        tag, flags, stored, raw = struct.unpack_from("<4sIQQ", kanim, 24 + 24 * i)
+        data = kanim[pos:pos + stored]
+        pos += stored
+        if flags & 1:
+            data = subprocess.run(["zstd", "-d", "-c"], input=data, capture_output=True, check=True).stdout
+            assert len(data) == raw
+        table.append(struct.pack("<4sIQQ", tag, flags & ~1, len(data), len(data)))
+        sections.append(data)
+    body = kanim[:24] + b"".join(table) + b"".join(sections)
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+def write(path: str, data: bytes) -> None:
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "wb") as f:
+        f.write(data)
+
+
+def main() -> None:
+    keyanim = sys.argv[1]
+    shared = sys.argv[2] if len(sys.argv) > 2 else os.path.join(ROOT, "..", "shared", "corpus")
+    corpus = os.path.join(HERE, "corpus")
+    rng = random.Random(20261122)
+
+    sources = {}  # seed name -> full BVH bytes
+    cmu = os.path.join(shared, "cmu")
+    picks = ["BVH-Examples__05_20-daz.bvh", "BVH-Examples__94_01.bvh", "BvhToDeepMimic__02_01.bvh",
+             "InverseKinematics__05_06.bvh", "bvh11__131_03.bvh", "makehuman-crlf__10_01.bvh",
+             "makehuman-lf__12_03.bvh"]
+    for name in picks:
+        with open(os.path.join(cmu, name), "rb") as f:
+            sources["cmu_" + name.split("__")[1][:-4]] = f.read()
+    for name in ["cmu_02_01_walk.bvh", "cmu_131_03_hop.bvh"]:
+        with open(os.path.join(ROOT, "data", name), "rb") as f:
+            sources["data_" + name[:-4]] = f.read()
+
+    fixtures = os.path.join(ROOT, "tests", "data", "bvh")
+    for name in sorted(os.listdir(fixtures)):
+        if name.endswith(".bvh"):
+            with open(os.path.join(fixtures, name), "rb") as f:
+                data = f.read()
+            write(os.path.join(corpus, "bvh", "fixture_" + name), data)
+            write(os.path.join(corpus, "roundtrip", "fixture_" + name), bytes([rng.randrange(256)]) + data)
+
+    snippets = {}
+    for index, (key, data) in enumerate(sorted(sources.items())):
+        write(os.path.join(corpus, "bvh", key + ".bvh"), cut_bvh(data, 3))
+        frames = max(2, min(20, 2000 // channels_of(data)))
+        snippets[key] = cut_bvh(data, frames)
+        for settings in ((0x00, 0x92), (0x4D, 0xE7))[index % 2]:
+            write(os.path.join(corpus, "roundtrip", "%s_s%02x.bvh" % (key, settings)),
+                  bytes([settings]) + snippets[key])
+
+    kanims = {}
+    for name in sorted(os.listdir(os.path.join(ROOT, "spec", "test-vectors"))):
+        if name.endswith(".kanim"):
+            with open(os.path.join(ROOT, "spec", "test-vectors", name), "rb") as f:
+                kanims["vector_" + name[:-6]] = f.read()
+    with tempfile.TemporaryDirectory() as tmp:
+        for key, bvh in sorted(snippets.items()):
+            src, dst = os.path.join(tmp, key + ".bvh"), os.path.join(tmp, key + ".kanim")
+            write(src, bvh)
+            for label, extra in (("", []), ("_coarse", ["--error", "1%", "--keys", "uniform:5"])):
+                r = subprocess.run([keyanim, "-q", "-f", "encode", src, "-o", dst] + extra, capture_output=True)
+                if r.returncode == 0:
+                    with open(dst, "rb") as f:
+                        kanims[key + label] = f.read()
+                    kanims[key + label + "_raw"] = uncompressed(kanims[key + label])
+                elif label == "":
+                    sys.exit("encode failed for %s: %s" % (key, r.stderr.decode()))
+    for key, data in sorted(kanims.items()):
+        write(os.path.join(corpus, "load", key + ".kanim"), data)
+        records = b""
+        for mode in range(16):  # every request kind once, then a few random ones
+            m = rng.randrange(256) if mode >= 8 else mode | (rng.randrange(8) << 3) | (rng.randrange(2) << 6)
+            records += bytes([m]) + struct.pack("<d", rng.uniform(-5, 60))
+        write(os.path.join(corpus, "sample", key + ".bin"), bytes([16]) + records + data)
+
+
+if __name__ == "__main__":
+    main()

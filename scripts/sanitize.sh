@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# The test suite under AddressSanitizer + UndefinedBehaviorSanitizer, then a short bounded run of
+# every fuzz target (fuzz/README.md) from its committed corpus. One build, build-asan: with clang
+# and libFuzzer it holds the tests and the fuzz targets; without them, a GCC build of the tests
+# only (the fuzz step is then skipped, with a message).
+#
+# Environment:
+#   KEYANIM_FUZZ_SECONDS   seconds per fuzz target (default 30; 0 skips fuzzing)
+#   KEYANIM_ASAN_EXCLUDE   ctest -E regex of tests left out of the sanitizer run (default: none;
+#                          the heaviest is the codec round trip of the whole shared corpus, about
+#                          65 s under ASan: "round-trips through .kanim")
+# A fuzz finding fails the script; the input is kept in build-asan/findings/<target>/ (see
+# fuzz/README.md for turning it into a committed seed).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+JOBS=$(nproc)
+FUZZ_SECONDS=${KEYANIM_FUZZ_SECONDS:-30}
+EXCLUDE=${KEYANIM_ASAN_EXCLUDE:-}
+B=build-asan
+
+CXX_FOR_ASAN=g++
+FUZZ=OFF
+if command -v clang++ >/dev/null &&
+   echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' |
+     clang++ -x c++ -fsanitize=fuzzer,address,undefined - -o /dev/null 2>/dev/null; then
+  CXX_FOR_ASAN=clang++
+  FUZZ=ON
+else
+  echo "sanitize: clang++ with libFuzzer not found (install clang and libclang-rt-14-dev): GCC, no fuzzing"
+fi
+# A build directory made with the other compiler cannot be reconfigured: start it anew.
+if [ -f "$B/CMakeCache.txt" ] && ! grep -q "^KEYANIM_ASAN_CXX:STRING=$CXX_FOR_ASAN\$" "$B/CMakeCache.txt"; then
+  rm -rf "$B"
+fi
+
+start=$(date +%s)
+# -O1: fast enough to run everything, while keeping stack traces readable.
+cmake -S . -B "$B" -DCMAKE_CXX_COMPILER="$CXX_FOR_ASAN" -DKEYANIM_ASAN_CXX:STRING="$CXX_FOR_ASAN" \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DKEYANIM_SANITIZE=address,undefined -DKEYANIM_BUILD_FUZZ=$FUZZ -DKEYANIM_BUILD_BENCH=OFF >/dev/null
+cmake --build "$B" -j"$JOBS"
+echo "sanitize: build took $(( $(date +%s) - start )) s"
+start=$(date +%s)
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+ctest --test-dir "$B" -j"$JOBS" --output-on-failure ${EXCLUDE:+-E "$EXCLUDE"}
+echo "sanitize: test suite under ASan+UBSan took $(( $(date +%s) - start )) s"
+
+if [ "$FUZZ" = OFF ] || [ "$FUZZ_SECONDS" -le 0 ]; then
+  echo "sanitize: no fuzzing"
+  exit 0
+fi
+start=$(date +%s)
+# fuzz TARGET: FUZZ_SECONDS of libFuzzer on a scratch copy of the corpus (the committed seeds
+# stay as they are); prints the final status line.
+fuzz() {
+  local t=$1 work=$B/fuzz-work/$1 found=$B/findings/$1 log=$B/fuzz_$1.log
+  rm -rf "$work"; mkdir -p "$work" "$found"
+  cp fuzz/corpus/"$t"/* "$work"/
+  local dict=()
+  case $t in bvh|roundtrip) dict=(-dict=fuzz/bvh.dict) ;; esac
+  if ! "$B"/fuzz/fuzz_"$t" "$work" "${dict[@]}" -max_total_time="$FUZZ_SECONDS" -rss_limit_mb=2048 \
+       -malloc_limit_mb=1024 -timeout=20 -max_len=65536 -artifact_prefix="$found"/ >"$log" 2>&1; then
+    tail -n 40 "$log"
+    echo "sanitize: fuzz_$t FOUND A PROBLEM; input kept in $found/"
+    return 1
+  fi
+  echo "sanitize: fuzz_$t: $(grep -E '^#[0-9]+' "$log" | tail -n 1)"
+}
+# One target per core.
+status=0
+for pair in "bvh load" "sample roundtrip"; do
+  pids=()
+  for t in $pair; do fuzz "$t" & pids+=($!); done
+  for p in "${pids[@]}"; do wait "$p" || status=1; done
+done
+echo "sanitize: fuzzing took $(( $(date +%s) - start )) s"
+exit $status
