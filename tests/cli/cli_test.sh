@@ -7,12 +7,7 @@ WALK="$DATA/cmu_02_01_walk.bvh"
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 cd "$T"
 
-die() { echo "FAIL: $*" >&2; exit 1; }
-expect_rc() {  # expect_rc CODE command...
-  local want=$1; shift
-  "$@" >"$T/.stdout" 2>"$T/.stderr"; local rc=$?
-  [ "$rc" -eq "$want" ] || { cat "$T/.stderr" >&2; die "'$*' exited $rc, expected $want"; }
-}
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
 
 case "$CASE" in

@@ -18,13 +18,8 @@ cleanup() {
 trap cleanup EXIT
 cd "$T"
 
-die() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 skip() { echo "skipped: $CASE: $*"; exit 0; }
-expect_rc() {  # expect_rc CODE command...
-  local want=$1; shift
-  "$@" >"$T/.stdout" 2>"$T/.stderr"; local rc=$?
-  [ "$rc" -eq "$want" ] || { cat "$T/.stderr" >&2; die "'$*' exited $rc, expected $want"; }
-}
 no_temps() {  # no_temps DIR: no temporary output left anywhere below DIR
   local left
   left=$(find "$1" -name '*.tmp.*' 2>/dev/null)

@@ -8,12 +8,7 @@ WALK="$DATA/cmu_02_01_walk.bvh"
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 cd "$T"
 
-die() { echo "FAIL: $*" >&2; exit 1; }
-expect_rc() {  # expect_rc CODE command...
-  local want=$1; shift
-  "$@" >"$T/.stdout" 2>"$T/.stderr"; local rc=$?
-  [ "$rc" -eq "$want" ] || { cat "$T/.stderr" >&2; die "'$*' exited $rc, expected $want"; }
-}
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 # Well-formed XML whose root is <svg> with a viewBox (python3 if present, else xmllint).
 well_formed() {
   if command -v python3 >/dev/null; then
