@@ -27,11 +27,9 @@ using keyanim::Status;
 
 constexpr size_t kRecord = 9;
 
-// Bit-exact, except that +0 and -0 count as equal. Known issue (reported, see
-// corpus/sample/crash-cursor-negative-zero.bin): a key value of -0 (q < 0 times a step so small
-// that the product rounds to -0) comes back from the cursor path as +0 at its own key frame,
-// where eval_channel returns v_j = -0. Make this strict (same_float) once that is fixed.
-bool same_value(float a, float b) { return (a == 0.0f && b == 0.0f) || keyanim::fuzz::same_float(a, b); }
+// Bit-exact, -0 included (corpus/sample/crash-cursor-negative-zero.bin: a key value of -0 once
+// came back from the cursor path as +0 at its own key frame).
+bool same_value(float a, float b) { return keyanim::fuzz::same_float(a, b); }
 
 float reference(const Clip& clip, uint32_t c, float f) {
   const keyanim::ChannelTrack& t = clip.track(c);

@@ -493,11 +493,11 @@ TEST_CASE("crafted counts are refused before any large allocation") {
   }
 }
 
-// Known issue, reported: the loader allocates (and zero-fills) Raw_Size bytes as soon as the
-// zstd frame header declares that content size, so 60 bytes can make it commit up to the 1 GiB
-// limit before zstd finds the frame holds 100 bytes. Within the spec's limit, but a cheap
-// denial of service for a runtime. Remove may_fail once get_content bounds (or stops touching)
-// the buffer it allocates from a declared size.
+// Known issue: the loader allocates Raw_Size bytes as soon as the zstd frame header declares
+// that content size (no longer zero-filled, so the memory is not touched), so 60 bytes can make
+// it reserve up to the 1 GiB limit before zstd finds the frame holds 100 bytes. Within the
+// spec's limit, but a cheap denial of service for a runtime. Remove may_fail once get_content
+// decompresses into a buffer that grows with what zstd actually produces.
 TEST_CASE("a tiny zstd frame declaring a 1 GiB section is refused without a large allocation" *
           doctest::may_fail()) {
   const bool probing = probe_works();

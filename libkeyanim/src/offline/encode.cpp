@@ -313,6 +313,12 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     }
   }
 
+  // A clip the container cannot store (a frame time of 0 with several frames, a value whose
+  // quantized integer overflows in the fixed-key modes) is an error, not a result.
+  if (std::string why = validate_encoded_clip(enc); !why.empty()) {
+    error = "cannot be stored: " + why;
+    return false;
+  }
   decode_all(to_clip(enc), decoded);
   out.error = measure_error(m, decoded);
   out.tolerance_units = tol_units;

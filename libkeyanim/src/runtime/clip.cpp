@@ -341,13 +341,15 @@ void Clip::refresh_cursor(uint32_t c, float f, SampleCursor& cursor) const noexc
   const float m0 = t.s * a0 * (p1 - pm);
   const float m1 = t.s * a1 * (p2 - p0);
   // At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as eval_channel's v_j, as
-  // long as the operands are finite; else K_j itself is left to a direct state.
+  // long as the operands are finite and p0 is not -0 (-0 + +0 is +0); else K_j itself is left
+  // to a direct state.
   const bool finite = std::isfinite(d) && std::isfinite(m0) && std::isfinite(m1);
-  if (!finite && f == k0) {
+  const bool exact_at_key = finite && p0 != 0.0f;
+  if (!exact_at_key && f == k0) {
     set_direct(p0, k0, std::nextafter(k0, kInf));
     return;
   }
-  st[kLo * C + c] = finite ? k0 : std::nextafter(k0, kInf);
+  st[kLo * C + c] = exact_at_key ? k0 : std::nextafter(k0, kInf);
   st[kHi * C + c] = k1;
   st[kK0 * C + c] = k0;
   st[kK1 * C + c] = k1;

@@ -97,7 +97,9 @@ class Loader {
   int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL
   int note_index_ = -1;
   std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx_;
-  std::vector<std::vector<uint8_t>> buffers_;  // decompressed sections, alive until parsed
+  // Decompressed sections, alive until parsed. Not zero-filled: a small file declaring a large
+  // section must not make the loader touch (commit) that memory before zstd has produced it.
+  std::vector<std::unique_ptr<uint8_t[]>> buffers_;
 
   // From CLIP.
   uint64_t key_count_ = 0;
@@ -238,13 +240,13 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out) 
     dctx_.reset(ZSTD_createDCtx());
     if (!dctx_) return fail(Status::zstd_error, name, e.file_offset, "cannot create a zstd context");
   }
-  buffers_.emplace_back(static_cast<size_t>(e.raw) + 1);  // +1: a valid pointer when raw is 0
-  std::vector<uint8_t>& buf = buffers_.back();
-  const size_t got = ZSTD_decompressDCtx(dctx_.get(), buf.data(), static_cast<size_t>(e.raw), src, stored);
+  buffers_.emplace_back(new uint8_t[static_cast<size_t>(e.raw) + 1]);  // +1: valid when raw is 0
+  uint8_t* buf = buffers_.back().get();
+  const size_t got = ZSTD_decompressDCtx(dctx_.get(), buf, static_cast<size_t>(e.raw), src, stored);
   if (ZSTD_isError(got))
     return fail(Status::zstd_error, name, e.file_offset, std::string("zstd: ") + ZSTD_getErrorName(got));
   if (got != e.raw) return fail(Status::zstd_error, name, e.file_offset, "the zstd frame decompressed to the wrong size");
-  out.data = buf.data();
+  out.data = buf;
   out.size = got;
   return Status::ok;
 }
