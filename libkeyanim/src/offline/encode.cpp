@@ -173,6 +173,20 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   // Tolerance in file units. A skeleton with no extent (a lone root) falls back to its path.
   const std::vector<Vec3> orig_pos = world_positions_all(m);
   const size_t n_nodes = m.skeleton.joints.size();
+  // Keys are binary32 at runtime: a value (or a position) beyond its range cannot play back.
+  constexpr double kMaxMagnitude = 1e37;
+  for (double v : m.values) {
+    if (!(std::fabs(v) <= kMaxMagnitude)) {
+      error = "a channel value is beyond what binary32 keys can hold (|v| > 1e37)";
+      return false;
+    }
+  }
+  for (const Vec3& p : orig_pos) {
+    if (!(std::fabs(p[0]) <= kMaxMagnitude && std::fabs(p[1]) <= kMaxMagnitude && std::fabs(p[2]) <= kMaxMagnitude)) {
+      error = "joint positions overflow (beyond 1e37 in file units)";
+      return false;
+    }
+  }
   const double size = reference_size(m);
   const double tol_units = settings.tolerance_in_percent ? settings.tolerance / 100.0 * size : settings.tolerance;
   if (!(tol_units > 0.0)) {
