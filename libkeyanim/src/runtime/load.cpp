@@ -10,12 +10,14 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "internal/byte_reader.h"
 #include "internal/format.h"
+#include "internal/zstd_bound.h"
 #include "internal/varint.h"
 #include "keyanim/clip.h"
 
@@ -236,6 +238,13 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out) 
     return fail(Status::zstd_error, name, e.file_offset, "Stored_Size is not exactly one zstd frame");
   if (e.raw > std::numeric_limits<size_t>::max())
     return fail(Status::limit_exceeded, name, e.file_offset, "section too large for this platform");
+  // Allocate Raw_Size only when the frame's blocks can produce it (zip-bomb headers).
+  const std::optional<uint64_t> bound = internal::zstd_frame_output_bound(src, stored);
+  if (!bound) return fail(Status::zstd_error, name, e.file_offset, "bad zstd block headers");
+  if (*bound < e.raw)
+    return fail(Status::zstd_error, name, e.file_offset,
+                "the zstd frame's blocks can produce at most " + std::to_string(*bound) + " bytes, Raw_Size is " +
+                    std::to_string(e.raw));
   if (!dctx_) {
     dctx_.reset(ZSTD_createDCtx());
     if (!dctx_) return fail(Status::zstd_error, name, e.file_offset, "cannot create a zstd context");
