@@ -24,14 +24,27 @@ enum class Interpolation : uint8_t {
 inline float tension_to_s(float tension) noexcept { return (1.0f - tension) * 0.5f; }
 inline float s_to_tension(float s) noexcept { return 1.0f - 2.0f * s; }
 
-// Value of segment j (between keys j and j+1, 0 <= j < n-1) of a channel whose n >= 2 keys sit
-// at strictly increasing frames `frames` with values `values`, at local parameter u in [0, 1].
-// End points are duplicated: P_{-1} = P_0 and P_n = P_{n-1}.
-inline float eval_segment(const uint32_t* frames, const float* values, uint32_t n, uint32_t j,
-                          float u, Interpolation interp, float s, TangentRule rule) noexcept {
+// What a segment's value depends on besides u: its start value, rise and end tangents.
+struct SegmentOperands {
+  float p0 = 0.0f;
+  float d = 0.0f;   // p1 - p0
+  float m0 = 0.0f;  // tangents (cardinal only)
+  float m1 = 0.0f;
+  bool linear = false;
+};
+
+// Operands of segment j (between keys j and j+1, 0 <= j < n-1) of a channel whose n >= 2 keys
+// sit at strictly increasing frames `frames` with values `values`. End points are duplicated:
+// P_{-1} = P_0 and P_n = P_{n-1}.
+inline SegmentOperands segment_operands(const uint32_t* frames, const float* values, uint32_t n, uint32_t j,
+                                        Interpolation interp, float s, TangentRule rule) noexcept {
+  SegmentOperands o;
   const float p0 = values[j];
   const float p1 = values[j + 1];
-  if (interp == Interpolation::linear) return p0 + u * (p1 - p0);
+  o.p0 = p0;
+  o.d = p1 - p0;
+  o.linear = interp == Interpolation::linear;
+  if (o.linear) return o;
   const float pm = values[j > 0 ? j - 1 : 0];
   const float p2 = values[j + 2 < n ? j + 2 : n - 1];
   float a0 = 1.0f;  // tangent scale at key j (outgoing)
@@ -47,15 +60,27 @@ inline float eval_segment(const uint32_t* frames, const float* values, uint32_t 
       a1 = 2.0f * len / (len + len_out);
     }
   }
-  const float m0 = s * a0 * (p1 - pm);
-  const float m1 = s * a1 * (p2 - p0);
+  o.m0 = s * a0 * (p1 - pm);
+  o.m1 = s * a1 * (p2 - p0);
+  return o;
+}
+
+// The segment's value at local parameter u in [0, 1].
+inline float eval_operands(const SegmentOperands& o, float u) noexcept {
+  if (o.linear) return o.p0 + u * o.d;
   const float u2 = u * u;
   const float u3 = u2 * u;
   const float h01 = -2.0f * u3 + 3.0f * u2;
   const float h10 = u3 - 2.0f * u2 + u;
   const float h11 = u3 - u2;
   // h00 = 1 - h01 folded in: equal keys with zero tangents give exactly the key value.
-  return p0 + h01 * (p1 - p0) + h10 * m0 + h11 * m1;
+  return o.p0 + h01 * o.d + h10 * o.m0 + h11 * o.m1;
+}
+
+// Value of segment j at local parameter u in [0, 1].
+inline float eval_segment(const uint32_t* frames, const float* values, uint32_t n, uint32_t j,
+                          float u, Interpolation interp, float s, TangentRule rule) noexcept {
+  return eval_operands(segment_operands(frames, values, n, j, interp, s, rule), u);
 }
 
 // Local parameter of frame position f in the segment from key frame k0 to k1 (binary32).

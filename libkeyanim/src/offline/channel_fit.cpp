@@ -70,10 +70,11 @@ void CurveFit::measure(uint32_t start, bool push) {
   frames[n] = start, values[n++] = v_[start];
   frames[n] = end, values[n++] = v_[end];
   if (next_[end] != kNone) frames[n] = next_[end], values[n++] = v_[next_[end]];
+  const SegmentOperands ops = segment_operands(frames, values, n, j, interp_, s_, rule_);
   double worst = 0.0;
   uint32_t arg = start + 1;
   for (uint32_t f = start + 1; f < end; ++f) {
-    const float v = eval_segment(frames, values, n, j, segment_u(start, end, float(f)), interp_, s_, rule_);
+    const float v = eval_operands(ops, segment_u(start, end, float(f)));
     const double r = std::fabs(double(v) - (*y_)[f]) / (*tol_)[f];
     if (r > worst) worst = r, arg = f;
   }

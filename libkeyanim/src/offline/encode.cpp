@@ -11,7 +11,6 @@
 #include <numbers>
 #include <sstream>
 #include <thread>
-#include <tuple>
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/curvature.h"
@@ -96,7 +95,7 @@ void decode_all(const Clip& clip, Motion& out) {
 }
 
 // One channel at every source frame, walking the segments in order: the same values as
-// Clip::sample (the same eval_segment calls) without a search per frame.
+// Clip::sample (eval_segment's operations) without a search per frame.
 void decode_channel(const Clip& clip, uint32_t c, std::vector<float>& out) {
   const ChannelTrack& t = clip.track(c);
   const std::span<const uint32_t> k = clip.key_frames(c);
@@ -105,11 +104,15 @@ void decode_channel(const Clip& clip, uint32_t c, std::vector<float>& out) {
   const uint32_t frames = uint32_t(out.size());
   if (n == 0) return std::fill(out.begin(), out.end(), 0.0f);
   uint32_t j = 0;
+  SegmentOperands ops;
   for (uint32_t f = 0; f < frames; ++f) {
     if (n == 1 || f <= k[0]) { out[f] = v[0]; continue; }
     if (f >= k[n - 1]) { out[f] = v[n - 1]; continue; }
-    while (k[j + 1] <= f) ++j;
-    out[f] = f == k[j] ? v[j] : eval_segment(k.data(), v.data(), n, j, segment_u(k[j], k[j + 1], float(f)), t.interp, t.s, clip.tangent_rule());
+    if (k[j + 1] <= f || f == k[0] + 1) {
+      while (k[j + 1] <= f) ++j;
+      ops = segment_operands(k.data(), v.data(), n, j, t.interp, t.s, clip.tangent_rule());
+    }
+    out[f] = f == k[j] ? v[j] : eval_operands(ops, segment_u(k[j], k[j + 1], float(f)));
   }
 }
 
@@ -252,6 +255,8 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   std::vector<Vec3> pos;
   std::vector<uint8_t> check(n_fr, 1);  // frames to verify: values changed, or over last round
   std::vector<uint32_t> refit;
+  std::vector<double> ratio(n_ch, 1.0);  // per channel, the tightening the current frame needs
+  std::vector<uint32_t> touched;         // channels with ratio < 1 at the current frame
   const uint32_t threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   uint32_t round = 0;
   for (;; ++round) {
@@ -294,8 +299,8 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
         if (column[f] != old || round == 0) old = column[f], check[f] = 1;
       }
     }
-    // (channel, frame, tightened tolerance) for every channel that moves an over-budget node.
-    std::vector<std::tuple<uint32_t, uint32_t, double>> tighten;
+    // Each channel that moves an over-budget node is tightened at that frame by the largest
+    // ratio any of its nodes needs. Frames come in order, so each channel's changed frames do too.
     bool over = false;
     for (uint32_t f = 0; f < n_fr; ++f) {
       if (!check[f]) continue;
@@ -303,27 +308,31 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
       world_positions(m.skeleton, decoded.values.data() + size_t(f) * n_ch, pos);
       for (size_t d = 0; d < n_nodes; ++d) {
         const Vec3& a = orig_pos[f * n_nodes + d];
-        const double e = std::hypot(pos[d][0] - a[0], pos[d][1] - a[1], pos[d][2] - a[2]);
+        // The formula of measure_error, so that what passes here passes the final report.
+        const double dx = pos[d][0] - a[0], dy = pos[d][1] - a[1], dz = pos[d][2] - a[2];
+        const double e = std::sqrt(dx * dx + dy * dy + dz * dz);
         if (e <= tol_units) continue;
         over = true;
         check[f] = 1;
-        const double r = kTightenMargin * tol_units / e;
-        for (uint32_t c : moving[d]) tighten.emplace_back(c, f, r * tol[c][f]);
+        const double r = kTightenMargin * tol_units / e;  // < kTightenMargin < 1
+        for (uint32_t c : moving[d]) {
+          if (ratio[c] == 1.0) touched.push_back(c);
+          ratio[c] = std::min(ratio[c], r);
+        }
       }
+      for (uint32_t c : touched) {
+        if (!dirty[c]) changed[c].clear(), dirty[c] = true;  // first tightening of this round
+        tol[c][f] *= ratio[c];
+        changed[c].push_back(f);
+        ratio[c] = 1.0;
+      }
+      touched.clear();
     }
     if (!over) break;
     if (round + 1 >= kMaxRounds) {
       error = "could not reach the tolerance of " + std::to_string(tol_units) +
               " units after " + std::to_string(kMaxRounds) + " rounds (below float32 precision?)";
       return false;
-    }
-    // Sorted by channel then frame: each channel's changed frames come out sorted.
-    std::sort(tighten.begin(), tighten.end());
-    for (const auto& [c, f, t] : tighten) {
-      if (!(t < tol[c][f])) continue;
-      if (!dirty[c]) changed[c].clear(), dirty[c] = true;  // first tightening of this round
-      tol[c][f] = t;
-      if (changed[c].empty() || changed[c].back() != f) changed[c].push_back(f);
     }
   }
 

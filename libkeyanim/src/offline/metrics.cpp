@@ -85,14 +85,15 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded) {
   const double samples = double(frames) * double(nodes);
   report.rms_error = samples > 0 ? std::sqrt(sum_sq / samples) : 0.0;
 
+  const size_t stride = channels;  // Motion::value would recount the channels at every call
   for (uint32_t j = 0; j < nodes; ++j) {
     const Joint& joint = original.skeleton.joints[j];
     for (size_t k = 0; k < joint.channels.size(); ++k) {
       const uint32_t c = joint.first_channel + static_cast<uint32_t>(k);
       double m = 0.0;
       for (uint32_t f = 0; f < frames; ++f) {
-        const double d = channel_difference(joint.channels[k], original.value(f, c),
-                                            decoded.value(f, c));
+        const double d = channel_difference(joint.channels[k], original.values[f * stride + c],
+                                            decoded.values[f * stride + c]);
         if (d > m) m = d;
       }
       report.channel_max[c] = m;
