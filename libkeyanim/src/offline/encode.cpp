@@ -252,6 +252,8 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   decoded.frame_count = n_fr;
   decoded.frame_time = m.frame_time;
   decoded.values.assign(size_t(n_fr) * n_ch, 0.0);
+  // Trigonometry of the decoded rotations, redone only where a value changes (FK's main cost).
+  std::vector<double> sines(decoded.values.size()), cosines(decoded.values.size());
   std::vector<Vec3> pos;
   std::vector<uint8_t> check(n_fr, 1);  // frames to verify: values changed, or over last round
   std::vector<uint32_t> refit;
@@ -295,8 +297,12 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     for (uint32_t c : refit) {
       decode_channel(clip, c, column);
       for (uint32_t f = 0; f < n_fr; ++f) {
-        double& old = decoded.values[size_t(f) * n_ch + c];
-        if (column[f] != old || round == 0) old = column[f], check[f] = 1;
+        const size_t at = size_t(f) * n_ch + c;
+        double& old = decoded.values[at];
+        if (column[f] != old || round == 0) {
+          old = column[f], check[f] = 1;
+          if (rot[c]) sin_cos_deg(old, sines[at], cosines[at]);
+        }
       }
     }
     // Each channel that moves an over-budget node is tightened at that frame by the largest
@@ -305,7 +311,8 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     for (uint32_t f = 0; f < n_fr; ++f) {
       if (!check[f]) continue;
       check[f] = 0;
-      world_positions(m.skeleton, decoded.values.data() + size_t(f) * n_ch, pos);
+      const size_t row = size_t(f) * n_ch;
+      world_positions(m.skeleton, decoded.values.data() + row, sines.data() + row, cosines.data() + row, pos);
       for (size_t d = 0; d < n_nodes; ++d) {
         const Vec3& a = orig_pos[f * n_nodes + d];
         // The formula of measure_error, so that what passes here passes the final report.

@@ -13,11 +13,13 @@ namespace {
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 constexpr Mat3 kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
-// sin and cos of an angle in degrees. Reducing to about [-45, 45] around the nearest multiple of
-// 90 first makes 90/180/270 exact and makes a +-360 shift change nothing (the reduced angle is
-// computed exactly; only an angle on a 45-degree tie may land in the other quadrant and differ in
-// the last bit), so FK agrees with channel errors compared modulo 360.
-inline void sin_cos_deg(double deg, double& s, double& c) noexcept {
+}  // namespace
+
+// Reducing to about [-45, 45] around the nearest multiple of 90 first makes 90/180/270 exact
+// and makes a +-360 shift change nothing (the reduced angle is computed exactly; only an angle
+// on a 45-degree tie may land in the other quadrant and differ in the last bit), so FK agrees
+// with channel errors compared modulo 360.
+void sin_cos_deg(double deg, double& s, double& c) noexcept {
   if (!(std::fabs(deg) < 1e15)) {  // NaN, inf or too large for an exact quadrant count
     s = std::sin(deg * kRadPerDeg);
     c = std::cos(deg * kRadPerDeg);
@@ -38,12 +40,11 @@ inline void sin_cos_deg(double deg, double& s, double& c) noexcept {
   }
 }
 
+namespace {
+
 // m = m * R_axis(angle). Only the two columns other than `axis` change:
 // col_a' = c*col_a + s*col_b, col_b' = c*col_b - s*col_a with (a, b) = (axis+1, axis+2) mod 3.
-inline void post_rotate(Mat3& m, int axis, double deg) noexcept {
-  double s;
-  double c;
-  sin_cos_deg(deg, s, c);
+inline void post_rotate(Mat3& m, int axis, double s, double c) noexcept {
   const int a = (axis + 1) % 3;
   const int b = (axis + 2) % 3;
   for (int r = 0; r < 3; ++r) {
@@ -58,8 +59,20 @@ inline bool is_root(const Joint& joint, size_t index) noexcept {
   return joint.parent < 0 || static_cast<size_t>(joint.parent) >= index;
 }
 
+struct ComputeSinCos {
+  void operator()(uint32_t /*column*/, double deg, double& s, double& c) const noexcept { sin_cos_deg(deg, s, c); }
+};
+struct GivenSinCos {
+  const double* sines;
+  const double* cosines;
+  void operator()(uint32_t column, double /*deg*/, double& s, double& c) const noexcept {
+    s = sines[column], c = cosines[column];
+  }
+};
+
 // The one FK loop everything else uses. pos and rot have room for every node.
-void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* rot) noexcept {
+template <typename SinCos>
+void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* rot, SinCos sin_cos) noexcept {
   const size_t n = skeleton.joints.size();
   for (size_t j = 0; j < n; ++j) {
     const Joint& joint = skeleton.joints[j];
@@ -72,7 +85,9 @@ void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* ro
     for (size_t k = 0; k < joint.channels.size(); ++k) {
       const ChannelType type = joint.channels[k];
       if (is_rotation(type)) {
-        post_rotate(r, channel_axis(type), v[k]);
+        double sn, cs;
+        sin_cos(joint.first_channel + uint32_t(k), v[k], sn, cs);
+        post_rotate(r, channel_axis(type), sn, cs);
       } else {
         t[static_cast<size_t>(channel_axis(type))] = v[k];
       }
@@ -95,7 +110,11 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row) {
   Mat3 m = kIdentity;
   const double* v = frame_row + joint.first_channel;
   for (size_t k = 0; k < joint.channels.size(); ++k) {
-    if (is_rotation(joint.channels[k])) post_rotate(m, channel_axis(joint.channels[k]), v[k]);
+    if (is_rotation(joint.channels[k])) {
+      double sn, cs;
+      sin_cos_deg(v[k], sn, cs);
+      post_rotate(m, channel_axis(joint.channels[k]), sn, cs);
+    }
   }
   return m;
 }
@@ -106,7 +125,16 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, std::vec
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n);
   out.resize(n);
-  pose_frame(skeleton, frame_row, out.data(), rotations.data());
+  pose_frame(skeleton, frame_row, out.data(), rotations.data(), ComputeSinCos{});
+}
+
+void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,
+                     std::vector<Vec3>& out) {
+  thread_local std::vector<Mat3> rotations;
+  const size_t n = skeleton.joints.size();
+  if (rotations.size() < n) rotations.resize(n);
+  out.resize(n);
+  pose_frame(skeleton, frame_row, out.data(), rotations.data(), GivenSinCos{sines, cosines});
 }
 
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
@@ -114,7 +142,7 @@ void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<V
   const size_t n = skeleton.joints.size();
   positions.resize(n);
   rotations.resize(n);
-  pose_frame(skeleton, frame_row, positions.data(), rotations.data());
+  pose_frame(skeleton, frame_row, positions.data(), rotations.data(), ComputeSinCos{});
 }
 
 std::vector<Vec3> world_positions_all(const Motion& motion) {
@@ -130,7 +158,7 @@ std::vector<Vec3> world_positions_all(const Motion& motion) {
   std::vector<Mat3> rotations(n);
   for (size_t f = 0; f < complete; ++f) {
     pose_frame(motion.skeleton, motion.values.data() + f * channels, out.data() + f * n,
-               rotations.data());
+               rotations.data(), ComputeSinCos{});
   }
   return out;
 }

@@ -35,6 +35,13 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row);
 // scratch buffer have reached the skeleton's size.
 void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out);
 
+// The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
+// row's value, at the channel's column): for callers that re-pose frames in which few values
+// change. Bit-identical to the plain call.
+void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines,
+                     const double* cosines, std::vector<Vec3>& out);
+// sin and cos of an angle in degrees, exactly as FK computes them.
+void sin_cos_deg(double deg, double& s, double& c) noexcept;
 // World positions and world rotations (R_world of each node; an End Site's is its parent's).
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
                 std::vector<Mat3>& rotations);
