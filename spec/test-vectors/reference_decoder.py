@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reference decoder for .kanim 1.0, written from spec/FORMAT.md alone.
+"""Reference decoder for .kanim 2.0 (and 1.0, Appendix E), written from spec/FORMAT.md alone.
 
 It shares no code with the C++ library: it parses the bytes, checks the rules of the spec,
 and evaluates Appendix A in binary32 (every operation computed in binary64 and rounded once to
@@ -100,7 +100,7 @@ def parse(data):
     if len(data) < 24:
         raise KanimError("truncated", "header")
     major, minor, header_flags, count, reserved = struct.unpack_from("<HHIII", data, 8)
-    if major != 1:
+    if major not in (1, 2):
         raise KanimError("unsupported_version", f"major {major}")
     if header_flags & 0xFFFF or reserved:
         raise KanimError("reserved_bits_set", "header")
@@ -192,8 +192,10 @@ def parse(data):
 
     # CHAN
     chan = content["CHAN"]
-    if len(chan) != 17 * C:
+    if len(chan) != (18 if major == 2 else 17) * C:
         raise KanimError("corrupt", "CHAN size")
+    # Value_Coding (2.0): 0 delta, 1 extrapolate; version 1 has only deltas.
+    coding = list(chan[17 * C:18 * C]) if major == 2 else [0] * C
     interp = list(chan[:C])
     tension = list(struct.unpack_from(f"<{C}f", chan, C))
     step = list(struct.unpack_from(f"<{C}d", chan, 5 * C))
@@ -207,6 +209,8 @@ def parse(data):
             raise KanimError("corrupt", f"channel {c} step")
         if key_count[c] > F:
             raise KanimError("corrupt", f"channel {c} key count")
+        if coding[c] > 1:
+            raise KanimError("reserved_bits_set", f"channel {c} value coding")
     if sum(key_count) != K:
         raise KanimError("corrupt", "Key_Count sum")
 
@@ -254,12 +258,28 @@ def parse(data):
                 return value
         raise KanimError("corrupt", "varint too long")
 
+    def prediction(c, qs, i):
+        """pred_i of section 4.5, in Python's exact integers (// is the floor)."""
+        if i == 0:
+            return 0
+        if i == 1 or coding[c] == 0:
+            return qs[i - 1]
+        k = frames[c]
+        d, g0, g1 = qs[i - 1] - qs[i - 2], k[i - 1] - k[i - 2], k[i] - k[i - 1]
+        if abs(d) < 2 ** 40 and g0 < 2 ** 16 and g1 < 2 ** 16:
+            return qs[i - 1] + (2 * d * g1 + g0) // (2 * g0)
+        return qs[i - 1] + d
+
     values = []
     for c in range(C):
-        q, vals = 0, []
-        for _ in range(key_count[c]):
+        qs, vals = [], []
+        for i in range(key_count[c]):
             u = plane_varint()
-            q += (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
+            r = (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
+            if abs(r) > (2 ** 57 if major == 2 else 2 ** 54):
+                raise KanimError("corrupt", f"channel {c} residual")
+            q = prediction(c, qs, i) + r
+            qs.append(q)
             if abs(q) > 2 ** 53:
                 raise KanimError("corrupt", f"channel {c} |q|")
             v = f32(float(q) * step[c])  # binary64 product, one rounding to binary32
@@ -331,8 +351,12 @@ def positions_for(frame_count):
         ps.append(i / 4.0)
         i += 1
     i = 1
-    while 24 + 0.75 * i <= last:  # then every 0.75 frame
+    while 24 + 0.75 * i <= min(last, 1024):  # then every 0.75 frame up to frame 1024
         ps.append(24 + 0.75 * i)
+        i += 1
+    i = 1
+    while 1024 + 250.5 * i <= last:  # then every 250.5 frames
+        ps.append(1024 + 250.5 * i)
         i += 1
     ps += [0.1, 1.0 / 3.0, last * 0.7 + 0.01, last - 1e-7 if last > 0 else 0.3, last + 0.5, last + 1e6]
     return ps

@@ -58,9 +58,9 @@ exit_codes)
   head -c 100 ok.kanim >cut.kanim
   expect_rc 2 "$K" decode cut.kanim -o cut.bvh
   [ ! -e cut.bvh ] || die "a failed decode left an output"
-  # A newer major version: the version field follows the 8-byte signature (little-endian u16).
-  cp ok.kanim v2.kanim; printf '\x02' | dd of=v2.kanim bs=1 seek=8 conv=notrunc 2>/dev/null
-  expect_rc 3 "$K" info v2.kanim
+  # A later major version: the version field follows the 8-byte signature (little-endian u16).
+  cp ok.kanim v9.kanim; printf '\x09' | dd of=v9.kanim bs=1 seek=8 conv=notrunc 2>/dev/null
+  expect_rc 3 "$K" info v9.kanim
   expect_rc 4 "$K" encode "$WALK" -o ok.kanim
   expect_rc 5 "$K" verify ok.kanim --against "$WALK" --max-error 0.0001%
   ;;

@@ -66,9 +66,9 @@ damaged_kanim)
   expect_rc 2 "$K" decode long.kanim -o long.bvh
   grep -q 'trailing_bytes' "$T/.stderr" || die "appended bytes are not reported: $(cat "$T/.stderr")"
   [ ! -e long.bvh ] || die "a failed decode left an output"
-  cp ok.kanim v2.kanim; printf '\x02' | dd of=v2.kanim bs=1 seek=8 conv=notrunc 2>/dev/null
-  expect_rc 3 "$K" decode v2.kanim -o v2.bvh
-  [ ! -e v2.bvh ] || die "an unsupported version left an output"
+  cp ok.kanim v9.kanim; printf '\x09' | dd of=v9.kanim bs=1 seek=8 conv=notrunc 2>/dev/null
+  expect_rc 3 "$K" decode v9.kanim -o v9.bvh
+  [ ! -e v9.bvh ] || die "an unsupported version left an output"
   expect_rc 2 "$K" verify bad.kanim
   no_temps .
   ;;

@@ -5,7 +5,9 @@
 // Crafted files are assembled here by a small builder with its own CRC-32, not by the writer,
 // so that a writer bug cannot hide a loader bug.
 #include <doctest/doctest.h>
+#include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -22,6 +24,7 @@
 
 #include "keyanim/cardinal.h"
 #include "keyanim/clip.h"
+#include "keyanim/version.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
 
@@ -38,7 +41,7 @@ using keyanim::offline::EncodedChannel;
 using keyanim::offline::EncodedClip;
 
 // ---------------------------------------------------------------------------------------------
-// Hand-built clips. The test vectors are made from the first four: never change them.
+// Hand-built clips. The test vectors are made from the first five: never change them.
 
 Joint node(const char* name, int32_t parent, double x, double y, double z, std::vector<ChannelType> ch,
            bool end_site = false) {
@@ -177,6 +180,35 @@ EncodedClip vector_long() {
   std::string notes;
   for (int i = 0; i < 12; ++i) notes += "note" + std::to_string(i) + "=the same words again and again\n";
   c.notes = notes;
+  return c;
+}
+
+// Version 2.0's value prediction (spec 4.5): ramps the extrapolation predicts exactly, halves
+// rounded up for positive and negative deltas, a gap of 2^16 frames or more and deltas of 2^40
+// or more (both fall back to repeating the delta), and a noisy channel that stays delta-coded.
+EncodedClip vector_predict() {
+  EncodedClip c;
+  c.skeleton.joints = {node("Root", -1, 0, 0, 0, {CT::x_position, CT::y_position, CT::z_position, CT::z_rotation}),
+                       node("Tip", 0, 0, 1, 0, {CT::x_rotation}, false)};
+  c.frame_count = 70001;
+  c.frame_time = 1.0 / 30.0;
+  c.tangent_rule = TangentRule::step_adjusted;
+  std::vector<uint32_t> far = {0, 100, 200, 300, 400, 500, 600, 700, 800, 900, 1000, 67000, 67100, 70000};
+  std::vector<int64_t> ramp;
+  for (uint32_t f : far) ramp.push_back(40 * int64_t(f));
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, far, ramp));
+  std::vector<uint32_t> tight = {0, 1, 3, 4, 6, 7, 9, 10, 12};
+  std::vector<int64_t> huge;
+  for (size_t i = 0; i < tight.size(); ++i) huge.push_back(int64_t(tight[i]) * (int64_t(1) << 41) - (int64_t(1) << 52));
+  c.channels.push_back(chan(kCard, 0.0f, 1e-12, tight, huge));
+  std::vector<uint32_t> halves = {0, 2, 3, 5, 6, 8, 9, 11, 12, 14, 15, 17, 18, 20};
+  std::vector<int64_t> up, down;
+  for (uint32_t f : halves) up.push_back(301 * int64_t(f) / 2), down.push_back(-(301 * int64_t(f) + 1) / 2 + 7);
+  c.channels.push_back(chan(kCard, 0.5f, 0.001, halves, up));
+  c.channels.push_back(chan(kLin, 0.0f, 0.001, halves, down));
+  std::vector<int64_t> noisy;
+  for (size_t i = 0; i < halves.size(); ++i) noisy.push_back((i * 7919) % 13 - 6);
+  c.channels.push_back(chan(kCard, 0.0f, 0.5, halves, noisy));
   return c;
 }
 
@@ -524,11 +556,15 @@ struct JsonParser {
   }
 };
 
-const char* const kVectorNames[] = {"v1_rules", "v1_uniform", "v1_single", "v1_long"};
+// Version 1.0 files are frozen (written by the 1.0 writer); the current writer makes the rest.
+const char* const kVectorNames[] = {"v1_rules", "v1_uniform", "v1_single", "v1_long",
+                                    "v2_rules", "v2_long", "v2_predict"};
 EncodedClip vector_clip(const std::string& name) {
-  if (name == "v1_rules") return vector_rules();
-  if (name == "v1_uniform") return vector_uniform();
-  if (name == "v1_single") return vector_single();
+  const std::string kind = name.substr(3);
+  if (kind == "rules") return vector_rules();
+  if (kind == "uniform") return vector_uniform();
+  if (kind == "single") return vector_single();
+  if (kind == "predict") return vector_predict();
   return vector_long();
 }
 std::string vector_path(const std::string& name, const char* ext) {
@@ -562,7 +598,7 @@ TEST_CASE("write then load equals to_clip bit-exactly") {
       REQUIRE_MESSAGE(l.status == Status::ok, l.err.section << " " << l.err.detail);
       check_same_clip(l.clip, ref);
       check_same_samples(l.clip, ref);
-      CHECK(l.clip.version_major() == 1);
+      CHECK(l.clip.version_major() == keyanim::kFormatVersionMajor);
       CHECK(l.clip.version_minor() == 0);
     }
   }
@@ -688,7 +724,7 @@ TEST_CASE("crafted headers: signature version flags") {
   CHECK_FAILS(std::vector<uint8_t>({'B', 'V', 'H'}), Status::bad_signature, 0);
   {
     RawFile r = base;
-    r.major = 2;
+    r.major = keyanim::kFormatVersionMajor + 1;
     CHECK_FAILS(r.build(), Status::unsupported_version, 8);
     r.major = 0;
     CHECK_FAILS(r.build(), Status::unsupported_version, 8);
@@ -962,6 +998,7 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
   CHECK_FAILS(with("CHAN", 5 * C + 8 * 3, 0.0), Status::corrupt, chan + 5 * C + 24);
   CHECK_FAILS(with("CHAN", 5 * C + 8 * 3, -0.1), Status::corrupt, chan + 5 * C + 24);
   CHECK_FAILS(with("CHAN", 13 * C + 4 * 4, uint32_t(13)), Status::corrupt, chan + 13 * C + 16);  // > F
+  CHECK_FAILS(with("CHAN", 17 * C + 1, uint8_t(2)), Status::reserved_bits_set, chan + 17 * C + 1);  // Value_Coding
   {
     RawFile r = base;
     r.get("CHAN").stored.pop_back();
@@ -996,8 +1033,9 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
     r.get("KTIM").stored.push_back(0);
     CHECK_FAILS(r.build(), Status::corrupt, ktim + base.sections[3].stored.size());
   }
-  // KVAL, rebuilt here from the quantized values of vector_uniform by the spec's text:
-  // zigzag deltas as LEB128 varints, byte k of each varint in plane k.
+  // KVAL, rebuilt here from the quantized values of vector_uniform by the spec's text: each
+  // channel's residuals under its Value_Coding (CHAN, 2.0) as zigzag LEB128 varints, byte k of
+  // each varint in plane k.
   auto varint = [](uint64_t x) {
     std::vector<uint8_t> v;
     for (;; x >>= 7) {
@@ -1006,9 +1044,26 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
     }
   };
   auto zigzag = [](int64_t d) { return d >= 0 ? uint64_t(d) * 2 : uint64_t(-(d + 1)) * 2 + 1; };
+  auto floor_div = [](int64_t a, int64_t b) { return a / b - ((a % b != 0 && a < 0) ? 1 : 0); };
   std::vector<std::vector<uint8_t>> varints;
-  for (const auto& ch : vector_uniform().channels)
-    for (size_t i = 0; i < ch.q.size(); ++i) varints.push_back(varint(zigzag(ch.q[i] - (i ? ch.q[i - 1] : 0))));
+  const auto chans = vector_uniform().channels;
+  for (size_t c = 0; c < chans.size(); ++c) {
+    const auto& k = chans[c].frames;
+    const auto& q = chans[c].q;
+    const uint8_t coding = base.sections[2].stored[17 * C + c];
+    REQUIRE(coding <= 1);
+    for (size_t i = 0; i < q.size(); ++i) {
+      int64_t pred = i ? q[i - 1] : 0;
+      if (coding == 1 && i >= 2) {
+        const int64_t d = q[i - 1] - q[i - 2], g0 = k[i - 1] - k[i - 2], g1 = k[i] - k[i - 1];
+        if (d > -(int64_t(1) << 40) && d < (int64_t(1) << 40) && g0 < 65536 && g1 < 65536)
+          pred += floor_div(2 * d * g1 + g0, 2 * g0);
+        else
+          pred += d;
+      }
+      varints.push_back(varint(zigzag(q[i] - pred)));
+    }
+  }
   auto planes = [](const std::vector<std::vector<uint8_t>>& vs) {
     std::vector<std::vector<uint8_t>> pl;
     for (const auto& v : vs)
@@ -1037,6 +1092,13 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
     vs[0] = varint(zigzag((int64_t(1) << 53)));
     vs[1] = varint(zigzag(1));  // 2^53 + 1 in the second key
     CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 8 + 1);
+  }
+  {
+    // A residual beyond 2^57 (nine planes), even though q would be in range after it.
+    auto vs = varints;
+    vs[0] = varint(zigzag((int64_t(1) << 57) + 1));
+    vs[1] = varint(zigzag(-(int64_t(1) << 57)));
+    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 9);
   }
   {
     auto vs = varints;
@@ -1237,9 +1299,9 @@ TEST_CASE("test vectors load and equal their hand-built clips") {
   for (const std::string name : kVectorNames) {
     CAPTURE(name);
     const EncodedClip e = vector_clip(name);
-    if (write) {
-      // v1_uniform is stored uncompressed, the others at level 19.
-      const auto bytes = keyanim::offline::write_kanim(e, name == "v1_uniform" ? 0 : 19);
+    if (write && name.starts_with("v" + std::to_string(keyanim::kFormatVersionMajor) + "_")) {
+      // v2_predict is stored uncompressed, the others at level 19.
+      const auto bytes = keyanim::offline::write_kanim(e, name == "v2_predict" ? 0 : 19);
       std::ofstream(vector_path(name, ".kanim"), std::ios::binary)
           .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     }
@@ -1248,6 +1310,31 @@ TEST_CASE("test vectors load and equal their hand-built clips") {
     const Clip ref = keyanim::offline::to_clip(e);
     check_same_clip(l.clip, ref);
     check_same_samples(l.clip, ref);
+  }
+}
+
+TEST_CASE("v2_predict holds both value codings and v2_long extrapolates") {
+  for (const char* name : {"v2_predict", "v2_long"}) {
+    CAPTURE(name);
+    const std::vector<uint8_t> bytes = read_file(vector_path(name, ".kanim"));
+    REQUIRE(bytes.size() > 12);
+    CHECK(bytes[8] == 2);
+    CHECK(bytes[9] == 0);
+    const Loaded l = load(bytes);
+    REQUIRE(l.status == Status::ok);
+    const size_t C = l.clip.channel_count();
+    std::vector<uint8_t> chan;
+    RawFile r = split(bytes);
+    chan = r.get("CHAN").stored;
+    if (r.get("CHAN").flags & 1) {
+      chan.assign(size_t(ZSTD_getFrameContentSize(chan.data(), chan.size())), 0);
+      const auto& z = r.get("CHAN").stored;
+      REQUIRE(ZSTD_decompress(chan.data(), chan.size(), z.data(), z.size()) == chan.size());
+    }
+    REQUIRE(chan.size() == 18 * C);
+    const std::vector<uint8_t> codings(chan.begin() + 17 * C, chan.end());
+    CHECK(std::count(codings.begin(), codings.end(), 1) >= 1);
+    if (std::string(name) == "v2_predict") CHECK(std::count(codings.begin(), codings.end(), 0) >= 1);
   }
 }
 
@@ -1267,6 +1354,9 @@ TEST_CASE("test vectors match the independent reference decoder") {
     const Loaded l = load(read_file(vector_path(name, ".kanim")));
     REQUIRE(l.status == Status::ok);
     const Clip& clip = l.clip;
+    CHECK(j["format_version"].str ==
+          std::to_string(clip.version_major()) + "." + std::to_string(clip.version_minor()));
+    CHECK(j["format_version"].str.substr(0, 1) == name.substr(1, 1));  // v1_* files are 1.x
     CHECK(j["frame_count"].num == clip.frame_count());
     CHECK(j["frame_time"].num == clip.frame_time());
     CHECK(j["tangent_rule"].num == double(static_cast<int>(clip.tangent_rule())));

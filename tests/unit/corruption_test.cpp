@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "keyanim/version.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
@@ -327,12 +328,16 @@ TEST_CASE("test vectors: versions") {
   for (const auto& path : test_vectors()) {
     INFO(path.filename().string());
     std::vector<uint8_t> f = read_bytes(path);
-    f[8] = 2;  // Major_Version 2: refused whatever the checksum says
+    const uint8_t major = f[8];
+    f[8] = uint8_t(keyanim::kFormatVersionMajor + 1);  // a later major: refused whatever the checksum says
     CHECK(load_fails(f) == Status::unsupported_version);
     fix_checksum(f);
     CHECK(load_fails(f) == Status::unsupported_version);
-    f[8] = 1;
-    f[10] = 7;  // Minor_Version 7: a 1.x decoder accepts any minor version
+    f[8] = 0;
+    fix_checksum(f);
+    CHECK(load_fails(f) == Status::unsupported_version);
+    f[8] = major;
+    f[10] = 7;  // Minor_Version 7: an x.y decoder accepts any minor version of its major
     fix_checksum(f);
     Clip clip;
     CHECK(Clip::load(f, clip) == Status::ok);

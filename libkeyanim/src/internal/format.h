@@ -35,7 +35,8 @@ inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTag
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count
-inline constexpr size_t kChanBytesPerChannel = 17;  // u8 + f32 + f64 + u32
+inline constexpr size_t kChanBytesPerChannel = 18;    // u8 + f32 + f64 + u32 + u8 (2.0)
+inline constexpr size_t kChanBytesPerChannelV1 = 17;  // 1.x: no Value_Coding
 inline constexpr uint8_t kNodeEndSite = 1u << 0;
 inline constexpr uint8_t kNodeReservedMask = 0xFEu;
 inline constexpr uint32_t kMaxNodeChannels = 6;
@@ -44,7 +45,7 @@ inline constexpr uint8_t kMaxTangentRule = 1;
 inline constexpr uint8_t kMaxInterpolation = 1;
 
 inline constexpr int64_t kMaxAbsQ = int64_t(1) << 53;      // |q| bound
-inline constexpr uint64_t kMaxAbsDelta = uint64_t(1) << 54;  // |q_i - q_{i-1}| bound
+inline constexpr uint64_t kMaxAbsDelta = uint64_t(1) << 54;  // 1.x: |q_i - q_{i-1}| bound
 inline constexpr uint32_t kMaxVarint32Bytes = 5;
 inline constexpr uint32_t kMaxVarint64Bytes = 10;
 

@@ -12,6 +12,7 @@
 
 #include "internal/byte_writer.h"
 #include "internal/format.h"
+#include "internal/value_coding.h"
 #include "internal/varint.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/version.h"
@@ -22,6 +23,39 @@ namespace {
 using internal::put_bytes;
 using internal::put_le;
 using internal::put_varint;
+using internal::ValueCoding;
+
+// Residuals of a channel's quantized values under a coding; false if one is out of range.
+bool residuals(const EncodedChannel& c, ValueCoding coding, std::vector<int64_t>& out) {
+  out.resize(c.q.size());
+  for (uint32_t i = 0; i < c.q.size(); ++i) {
+    const int64_t q1 = i > 0 ? c.q[i - 1] : 0, q2 = i > 1 ? c.q[i - 2] : 0;
+    const int64_t r = c.q[i] - internal::predict_q(coding, c.frames.data(), i, q1, q2);
+    if (r > int64_t(internal::kMaxAbsResidual) || r < -int64_t(internal::kMaxAbsResidual)) return false;
+    out[i] = r;
+  }
+  return true;
+}
+
+size_t varint_bytes(const std::vector<int64_t>& r) {
+  size_t n = 0;
+  for (int64_t x : r)
+    for (uint64_t u = internal::zigzag_encode(x); ; u >>= 7) { ++n; if (u < 128) break; }
+  return n;
+}
+
+// Per channel, the coding whose residual varints are shorter (delta on a tie): extrapolation
+// pays on smooth channels with sparse keys and loses on noisy ones (spec Appendix D).
+std::vector<ValueCoding> choose_codings(const std::vector<EncodedChannel>& chans) {
+  std::vector<ValueCoding> out(chans.size(), ValueCoding::delta);
+  std::vector<int64_t> d, e;
+  for (size_t c = 0; c < chans.size(); ++c) {
+    residuals(chans[c], ValueCoding::delta, d);  // |q| <= 2^53: always in range
+    if (residuals(chans[c], ValueCoding::extrapolate, e) && varint_bytes(e) < varint_bytes(d))
+      out[c] = ValueCoding::extrapolate;
+  }
+  return out;
+}
 
 std::string channel_problem(const EncodedChannel& ch, uint32_t frame_count) {
   if (static_cast<uint8_t>(ch.interp) > internal::kMaxInterpolation) return "unknown interpolation";
@@ -67,13 +101,14 @@ std::vector<uint8_t> skel_section(const Skeleton& skel) {
 }
 
 // Column by column: values of one kind sit together and compress better.
-std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans) {
+std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans, const std::vector<ValueCoding>& codings) {
   std::vector<uint8_t> s;
   s.reserve(chans.size() * internal::kChanBytesPerChannel);
   for (const auto& c : chans) put_le<uint8_t>(s, static_cast<uint8_t>(c.interp));
   for (const auto& c : chans) put_le<float>(s, c.tension);
   for (const auto& c : chans) put_le<double>(s, c.step);
   for (const auto& c : chans) put_le<uint32_t>(s, static_cast<uint32_t>(c.frames.size()));
+  for (ValueCoding v : codings) put_le<uint8_t>(s, static_cast<uint8_t>(v));
   return s;
 }
 
@@ -89,16 +124,16 @@ std::vector<uint8_t> ktim_section(const std::vector<EncodedChannel>& chans) {
 // The value varints split into byte planes: plane k holds the k-th byte of every varint that
 // has one. First bytes (mostly small deltas), and the rarer high bytes, then each form a
 // stream of like statistics, which zstd codes 5-9 % smaller than the varints in sequence.
-std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans) {
+std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans, const std::vector<ValueCoding>& codings) {
   std::vector<uint8_t> planes[internal::kMaxVarint64Bytes];
   std::vector<uint8_t> one;
-  for (const auto& c : chans) {
-    int64_t prev = 0;
-    for (int64_t q : c.q) {
+  std::vector<int64_t> r;
+  for (size_t c = 0; c < chans.size(); ++c) {
+    residuals(chans[c], codings[c], r);  // in range: choose_codings checked
+    for (int64_t x : r) {
       one.clear();
-      put_varint(one, internal::zigzag_encode(q - prev));  // |q| <= 2^53: no overflow
+      put_varint(one, internal::zigzag_encode(x));
       for (size_t k = 0; k < one.size(); ++k) planes[k].push_back(one[k]);
-      prev = q;
     }
   }
   uint8_t count = 0;
@@ -240,11 +275,12 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
   std::vector<Section> sections;
   sections.push_back(make_section(internal::kTagClip, 0, clip_section(clip, keys), nullptr, level));
   sections.push_back(make_section(internal::kTagSkel, 0, skel_section(clip.skeleton), cctx, level));
-  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels), cctx, level));
+  const std::vector<ValueCoding> codings = choose_codings(clip.channels);
+  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels, codings), cctx, level));
   sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
   {
     // With and without block breaks at the planes: the breaks usually win (by 0-7 %), not always.
-    std::vector<uint8_t> kval = kval_section(clip.channels);
+    std::vector<uint8_t> kval = kval_section(clip.channels, codings);
     const std::vector<size_t> breaks = kval_breaks(kval);
     Section split = make_section(internal::kTagKval, 0, kval, cctx, level, breaks);
     Section whole = make_section(internal::kTagKval, 0, std::move(kval), cctx, level);

@@ -17,9 +17,11 @@
 
 #include "internal/byte_reader.h"
 #include "internal/format.h"
+#include "internal/value_coding.h"
 #include "internal/zstd_bound.h"
 #include "internal/varint.h"
 #include "keyanim/clip.h"
+#include "keyanim/version.h"
 
 namespace keyanim {
 namespace {
@@ -94,6 +96,7 @@ class Loader {
   const DecodeLimits& limits_;
   ErrorInfo* err_;
 
+  uint16_t major_ = 0;
   uint16_t minor_ = 0;
   std::vector<TableEntry> table_;
   int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL
@@ -109,6 +112,7 @@ class Loader {
   uint32_t channel_count_ = 0;
   // From CHAN, needed by KVAL.
   std::vector<double> steps_;
+  std::vector<internal::ValueCoding> codings_;  // all delta in 1.x
 };
 
 Status Loader::read_header_and_table() {
@@ -129,9 +133,11 @@ Status Loader::read_header_and_table() {
   r.read(header_flags);
   r.read(section_count);
   r.read(reserved);
-  if (major != 1)
+  if (major < kOldestFormatVersionMajor || major > kFormatVersionMajor)
     return fail(Status::unsupported_version, "header", 8,
-                "major version " + std::to_string(major) + " (this decoder reads version 1)");
+                "major version " + std::to_string(major) + " (this decoder reads versions " +
+                    std::to_string(kOldestFormatVersionMajor) + " to " + std::to_string(kFormatVersionMajor) + ")");
+  major_ = major;
   if (header_flags & internal::kHeaderReservedMask)
     return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
   if (reserved != 0) return fail(Status::reserved_bits_set, "header", 20, "Header_Reserved is not 0");
@@ -361,11 +367,13 @@ Status Loader::parse_skel(const Content& c, Clip::Parts& parts) {
 
 Status Loader::parse_chan(const Content& c, Clip::Parts& parts) {
   const uint64_t channels = channel_count_;
-  if (c.size != channels * internal::kChanBytesPerChannel)
-    return fail_in(Status::corrupt, c, 0, "CHAN must be 17 x Channel_Count bytes");
+  const size_t per_channel = major_ >= 2 ? internal::kChanBytesPerChannel : internal::kChanBytesPerChannelV1;
+  if (c.size != channels * per_channel)
+    return fail_in(Status::corrupt, c, 0, "CHAN must be " + std::to_string(per_channel) + " x Channel_Count bytes");
   const uint8_t* p = c.data;
   parts.tracks.resize(channels);
   steps_.resize(channels);
+  codings_.assign(channels, internal::ValueCoding::delta);
   uint64_t key_sum = 0;
   for (uint64_t i = 0; i < channels; ++i) {
     const std::string ch = "channel " + std::to_string(i) + ": ";
@@ -383,6 +391,12 @@ Status Loader::parse_chan(const Content& c, Clip::Parts& parts) {
       return fail_in(Status::corrupt, c, at_step, ch + "Step must be finite and > 0");
     if (count > parts.frame_count)
       return fail_in(Status::corrupt, c, at_count, ch + "more keys than frames");
+    if (major_ >= 2) {
+      const size_t at_coding = 17 * channels + i;
+      if (p[at_coding] > internal::kMaxValueCoding)
+        return fail_in(Status::reserved_bits_set, c, at_coding, ch + "reserved Value_Coding " + std::to_string(p[at_coding]));
+      codings_[i] = static_cast<internal::ValueCoding>(p[at_coding]);
+    }
     ChannelTrack& t = parts.tracks[i];
     t.first_key = static_cast<uint32_t>(key_sum);  // key_sum <= Key_Count < 2^32 checked below
     t.key_count = count;
@@ -472,7 +486,11 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
   for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
     const ChannelTrack& t = parts.tracks[ch];
     const double step = steps_[ch];
-    int64_t q = 0;
+    const internal::ValueCoding coding = codings_[ch];
+    const uint32_t* kf = parts.key_frames.data() + t.first_key;  // KTIM is parsed before KVAL
+    // 1.x stores deltas up to 2^54; 2.x residuals up to 2^57, so |prediction + residual| < 2^58.
+    const uint64_t max_residual = major_ >= 2 ? internal::kMaxAbsResidual : internal::kMaxAbsDelta;
+    int64_t q = 0, q_prev = 0;
     for (uint32_t i = 0; i < t.key_count; ++i) {
       const size_t first_at = base[0] + pos[0];
       // The varint's k-th byte is the next unread byte of plane k (section 6.1 rules). Plane 0
@@ -495,10 +513,13 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
           }
         }
       }
-      // zigzag: |d| = (v + 1) / 2 without overflow.
-      if ((v >> 1) + (v & 1) > internal::kMaxAbsDelta)
-        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": a delta beyond 2^54");
-      q += internal::zigzag_decode(v);
+      // zigzag: |r| = (v + 1) / 2 without overflow.
+      if ((v >> 1) + (v & 1) > max_residual)
+        return fail_in(Status::corrupt, c, first_at,
+                       "channel " + std::to_string(ch) + (major_ >= 2 ? ": a residual beyond 2^57" : ": a delta beyond 2^54"));
+      const int64_t predicted = internal::predict_q(coding, kf, i, q, q_prev);
+      q_prev = q;
+      q = predicted + internal::zigzag_decode(v);
       if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ)
         return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": |q| > 2^53");
       const float value = dequantize(q, step);
@@ -515,7 +536,7 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
 Status Loader::run(Clip::Parts& parts) {
   Status s = read_header_and_table();
   if (s != Status::ok) return s;
-  parts.version_major = 1;
+  parts.version_major = major_;
   parts.version_minor = minor_;
   // Sections in table order (the critical ones are in order by now); unknown ancillary
   // sections are skipped without being decompressed.
