@@ -257,6 +257,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   std::vector<Vec3> pos;
   std::vector<uint8_t> check(n_fr, 1);  // frames to verify: values changed, or over last round
   std::vector<uint32_t> refit;
+  const double surely_within = tol_units * tol_units * (1.0 - 1e-9);
   std::vector<double> ratio(n_ch, 1.0);  // per channel, the tightening the current frame needs
   std::vector<uint32_t> touched;         // channels with ratio < 1 at the current frame
   const uint32_t threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
@@ -315,9 +316,12 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
       world_positions(m.skeleton, decoded.values.data() + row, sines.data() + row, cosines.data() + row, pos);
       for (size_t d = 0; d < n_nodes; ++d) {
         const Vec3& a = orig_pos[f * n_nodes + d];
-        // The formula of measure_error, so that what passes here passes the final report.
+        // The formula of measure_error, so that what passes here passes the final report; the
+        // square is compared first against a bound safely inside it (sqrt is correctly rounded).
         const double dx = pos[d][0] - a[0], dy = pos[d][1] - a[1], dz = pos[d][2] - a[2];
-        const double e = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const double sq = dx * dx + dy * dy + dz * dz;
+        if (sq <= surely_within) continue;
+        const double e = std::sqrt(sq);
         if (e <= tol_units) continue;
         over = true;
         check[f] = 1;
