@@ -279,12 +279,11 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
   sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels, codings), cctx, level));
   sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
   {
-    // With and without block breaks at the planes: the breaks usually win (by 0-7 %), not always.
+    // A block per plane: each gets its own entropy tables. (Also compressing without the
+    // breaks and keeping the smaller won 0.005% on the CMU clips for a fifth of the encode.)
     std::vector<uint8_t> kval = kval_section(clip.channels, codings);
     const std::vector<size_t> breaks = kval_breaks(kval);
-    Section split = make_section(internal::kTagKval, 0, kval, cctx, level, breaks);
-    Section whole = make_section(internal::kTagKval, 0, std::move(kval), cctx, level);
-    sections.push_back(split.stored.size() <= whole.stored.size() ? std::move(split) : std::move(whole));
+    sections.push_back(make_section(internal::kTagKval, 0, std::move(kval), cctx, level, breaks));
   }
   if (!clip.notes.empty()) {
     std::vector<uint8_t> text(clip.notes.begin(), clip.notes.end());

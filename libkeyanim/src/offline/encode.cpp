@@ -97,15 +97,17 @@ void decode_all(const Clip& clip, Motion& out) {
   }
 }
 
-// One channel at every source frame, walking the segments in order: the same values as
-// Clip::sample (eval_segment's operations) without a search per frame.
-void decode_channel(const Clip& clip, uint32_t c, std::vector<float>& out) {
-  const ChannelTrack& t = clip.track(c);
-  const std::span<const uint32_t> k = clip.key_frames(c);
-  const std::span<const float> v = clip.key_values(c);
-  const uint32_t n = t.key_count;
+// One channel at every source frame, walking the segments in order: the values Clip::sample
+// gives for the channel once stored (to_clip's dequantization, eval_segment's operations),
+// without building a Clip or searching per frame.
+void decode_channel(const EncodedChannel& ch, TangentRule rule, std::vector<float>& out, std::vector<float>& v) {
+  const uint32_t* k = ch.frames.data();
+  const uint32_t n = uint32_t(ch.frames.size());
   const uint32_t frames = uint32_t(out.size());
   if (n == 0) return std::fill(out.begin(), out.end(), 0.0f);
+  v.resize(n);
+  for (uint32_t i = 0; i < n; ++i) v[i] = dequantize(ch.q[i], ch.step);
+  const float s = tension_to_s(ch.tension);
   uint32_t j = 0;
   SegmentOperands ops;
   for (uint32_t f = 0; f < frames; ++f) {
@@ -113,7 +115,7 @@ void decode_channel(const Clip& clip, uint32_t c, std::vector<float>& out) {
     if (f >= k[n - 1]) { out[f] = v[n - 1]; continue; }
     if (k[j + 1] <= f || f == k[0] + 1) {
       while (k[j + 1] <= f) ++j;
-      ops = segment_operands(k.data(), v.data(), n, j, t.interp, t.s, clip.tangent_rule());
+      ops = segment_operands(k, v.data(), n, j, ch.interp, s, rule);
     }
     out[f] = f == k[j] ? v[j] : eval_operands(ops, segment_u(k[j], k[j + 1], float(f)));
   }
@@ -296,10 +298,9 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     // Verify by FK on what the decoder produces, on the frames whose values changed (and those
     // still over budget). Where a node is over budget, every channel that moves it is tightened
     // at that frame by the ratio it is over (plus a margin).
-    const Clip clip = to_clip(enc);
-    std::vector<float> column(n_fr);
+    std::vector<float> column(n_fr), key_values;
     for (uint32_t c : refit) {
-      decode_channel(clip, c, column);
+      decode_channel(enc.channels[c], enc.tangent_rule, column, key_values);
       for (uint32_t f = 0; f < n_fr; ++f) {
         const size_t at = size_t(f) * n_ch + c;
         double& old = decoded.values[at];
