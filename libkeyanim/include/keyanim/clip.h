@@ -58,21 +58,21 @@ class Clip {
   static Status load_file(const std::string& path, Clip& out, ErrorInfo* err = nullptr,
                           const DecodeLimits& limits = {});
 
-  uint16_t version_major() const noexcept { return version_major_; }
-  uint16_t version_minor() const noexcept { return version_minor_; }
-  uint32_t frame_count() const noexcept { return frame_count_; }
-  double frame_time() const noexcept { return frame_time_; }
+  uint16_t version_major() const noexcept { return p_.version_major; }
+  uint16_t version_minor() const noexcept { return p_.version_minor; }
+  uint32_t frame_count() const noexcept { return p_.frame_count; }
+  double frame_time() const noexcept { return p_.frame_time; }
   // (frame_count - 1) * frame_time, or 0 for an empty clip.
   double duration() const noexcept;
-  uint32_t channel_count() const noexcept { return static_cast<uint32_t>(tracks_.size()); }
-  TangentRule tangent_rule() const noexcept { return rule_; }
-  const Skeleton& skeleton() const noexcept { return skeleton_; }
-  const ChannelTrack& track(uint32_t c) const noexcept { return tracks_[c]; }
+  uint32_t channel_count() const noexcept { return static_cast<uint32_t>(p_.tracks.size()); }
+  TangentRule tangent_rule() const noexcept { return p_.rule; }
+  const Skeleton& skeleton() const noexcept { return p_.skeleton; }
+  const ChannelTrack& track(uint32_t c) const noexcept { return p_.tracks[c]; }
   std::span<const uint32_t> key_frames(uint32_t c) const noexcept;
   std::span<const float> key_values(uint32_t c) const noexcept;
-  uint64_t total_keys() const noexcept { return key_frames_.size(); }
+  uint64_t total_keys() const noexcept { return p_.key_frames.size(); }
   // Informative encoder notes stored in the file (settings, measured error), as key=value text.
-  const std::string& encoder_notes() const noexcept { return notes_; }
+  const std::string& encoder_notes() const noexcept { return p_.notes; }
   // Bytes held by this object (key arrays, tracks, skeleton, notes, the segment index), for
   // memory budgets. The segment index is never larger than half the key arrays.
   size_t memory_bytes() const noexcept;
@@ -117,15 +117,7 @@ class Clip {
   void sample_cursor(float f, float* out, SampleCursor& cursor) const noexcept;
   void refresh_cursor(uint32_t c, float f, SampleCursor& cursor) const noexcept;
 
-  uint16_t version_major_ = 0, version_minor_ = 0;
-  uint32_t frame_count_ = 0;
-  double frame_time_ = 0.0;
-  TangentRule rule_ = TangentRule::step_adjusted;
-  Skeleton skeleton_;
-  std::vector<ChannelTrack> tracks_;
-  std::vector<uint32_t> key_frames_;
-  std::vector<float> key_values_;
-  std::string notes_;
+  Parts p_;  // what the file holds; the members below are built from it
   // Segment index: for bucket b (frames [b << index_shift_, (b + 1) << index_shift_)) and
   // channel c, index_[b * channel_count + c] is the absolute key index of the segment holding
   // the bucket's first frame: a lower bound for any f in the bucket. Empty when not worth it.

@@ -16,16 +16,7 @@ namespace keyanim {
 
 Clip Clip::from_parts(Parts parts) {
   Clip c;
-  c.version_major_ = parts.version_major;
-  c.version_minor_ = parts.version_minor;
-  c.frame_count_ = parts.frame_count;
-  c.frame_time_ = parts.frame_time;
-  c.rule_ = parts.rule;
-  c.skeleton_ = std::move(parts.skeleton);
-  c.tracks_ = std::move(parts.tracks);
-  c.key_frames_ = std::move(parts.key_frames);
-  c.key_values_ = std::move(parts.key_values);
-  c.notes_ = std::move(parts.notes);
+  c.p_ = std::move(parts);
   c.build_index();
   static std::atomic<uint64_t> next_id{1};
   c.id_ = next_id.fetch_add(1, std::memory_order_relaxed);
@@ -40,11 +31,11 @@ void Clip::build_index() {
   index_.clear();
   index_shift_ = 0;
   index_buckets_ = 0;
-  const uint64_t channels = tracks_.size();
-  const uint64_t keys = key_frames_.size();
-  if (channels == 0 || frame_count_ < 2 || keys == 0) return;
+  const uint64_t channels = p_.tracks.size();
+  const uint64_t keys = p_.key_frames.size();
+  if (channels == 0 || p_.frame_count < 2 || keys == 0) return;
   // Interior positions f satisfy K_0 < f < K_{n-1} <= F - 1, so buckets of frames 0 .. F-2.
-  const uint64_t last = frame_count_ - 2;
+  const uint64_t last = p_.frame_count - 2;
   uint32_t shift = 0;
   for (; shift < 32; ++shift) {
     const uint64_t buckets = (last >> shift) + 1;
@@ -65,8 +56,8 @@ void Clip::build_index() {
   };
   std::vector<Walk> walk(channels);
   for (uint64_t c = 0; c < channels; ++c) {
-    const ChannelTrack& t = tracks_[c];
-    const uint32_t* fr = key_frames_.data() + t.first_key;
+    const ChannelTrack& t = p_.tracks[c];
+    const uint32_t* fr = p_.key_frames.data() + t.first_key;
     static const uint32_t kNever = UINT32_MAX;  // channels without segments never advance
     walk[c] = t.key_count < 2 ? Walk{&kNever, &kNever, t.first_key}
                               : Walk{fr + 1, fr + t.key_count - 1, t.first_key};
@@ -90,28 +81,28 @@ void Clip::build_index() {
 }
 
 double Clip::duration() const noexcept {
-  return frame_count_ == 0 ? 0.0 : static_cast<double>(frame_count_ - 1) * frame_time_;
+  return p_.frame_count == 0 ? 0.0 : static_cast<double>(p_.frame_count - 1) * p_.frame_time;
 }
 
 std::span<const uint32_t> Clip::key_frames(uint32_t c) const noexcept {
-  const ChannelTrack& t = tracks_[c];
-  return {key_frames_.data() + t.first_key, t.key_count};
+  const ChannelTrack& t = p_.tracks[c];
+  return {p_.key_frames.data() + t.first_key, t.key_count};
 }
 
 std::span<const float> Clip::key_values(uint32_t c) const noexcept {
-  const ChannelTrack& t = tracks_[c];
-  return {key_values_.data() + t.first_key, t.key_count};
+  const ChannelTrack& t = p_.tracks[c];
+  return {p_.key_values.data() + t.first_key, t.key_count};
 }
 
 size_t Clip::memory_bytes() const noexcept {
   size_t n = sizeof(Clip);
-  n += tracks_.capacity() * sizeof(ChannelTrack);
-  n += key_frames_.capacity() * sizeof(uint32_t);
-  n += key_values_.capacity() * sizeof(float);
+  n += p_.tracks.capacity() * sizeof(ChannelTrack);
+  n += p_.key_frames.capacity() * sizeof(uint32_t);
+  n += p_.key_values.capacity() * sizeof(float);
   n += index_.capacity() * sizeof(uint32_t);
-  n += notes_.capacity();
-  n += skeleton_.joints.capacity() * sizeof(Joint);
-  for (const Joint& j : skeleton_.joints) {
+  n += p_.notes.capacity();
+  n += p_.skeleton.joints.capacity() * sizeof(Joint);
+  for (const Joint& j : p_.skeleton.joints) {
     n += j.name.capacity() > 15 ? j.name.capacity() : 0;  // beyond the small-string buffer
     n += j.channels.capacity() * sizeof(ChannelType);
   }
@@ -124,7 +115,7 @@ const uint32_t* Clip::index_row(float f) const noexcept {
   // entry is segment 0), f past the table the last bucket.
   const double fd = f > 0.0f ? std::min(static_cast<double>(f), 4294967295.0) : 0.0;
   const uint64_t b = std::min<uint64_t>(static_cast<uint64_t>(fd) >> index_shift_, index_buckets_ - 1);
-  return index_.data() + b * tracks_.size();
+  return index_.data() + b * p_.tracks.size();
 }
 
 namespace {
@@ -260,7 +251,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 void Clip::sample_batch(float f, const uint32_t* channels, uint32_t count, float* out) const noexcept {
   const uint32_t* row = index_row(f);
-  const bool step_adjusted = rule_ == TangentRule::step_adjusted;
+  const bool step_adjusted = p_.rule == TangentRule::step_adjusted;
   Batch b;
   float res[kChunk];
   auto run = [&](auto le) {
@@ -268,7 +259,7 @@ void Clip::sample_batch(float f, const uint32_t* channels, uint32_t count, float
       const uint32_t m = std::min(kChunk, count - base);
       for (uint32_t i = 0; i < m; ++i) {
         const uint32_t c = channels != nullptr ? channels[base + i] : base + i;
-        gather(b, i, tracks_[c], key_frames_.data(), key_values_.data(), f, le, row != nullptr ? row + c : nullptr,
+        gather(b, i, p_.tracks[c], p_.key_frames.data(), p_.key_values.data(), f, le, row != nullptr ? row + c : nullptr,
                step_adjusted);
       }
       for (uint32_t i = m; i < kChunk; ++i) b.set_direct(i, 0.0f);
@@ -277,7 +268,7 @@ void Clip::sample_batch(float f, const uint32_t* channels, uint32_t count, float
     }
   };
   // Key frames are < frame_count: all below 2^24 when frame_count <= 2^24.
-  if (frame_count_ <= (1u << 24))
+  if (p_.frame_count <= (1u << 24))
     run(IntLE(f));
   else
     run(FloatLE{f});
@@ -299,10 +290,10 @@ void Clip::refresh_cursor(uint32_t c, float f, SampleCursor& cursor) const noexc
     fl[kLinearMask * C + c] = 0;
     fl[kDirectMask * C + c] = ~0u;
   };
-  const ChannelTrack& t = tracks_[c];
+  const ChannelTrack& t = p_.tracks[c];
   const uint32_t n = t.key_count;
-  const uint32_t* fr = key_frames_.data() + t.first_key;
-  const float* va = key_values_.data() + t.first_key;
+  const uint32_t* fr = p_.key_frames.data() + t.first_key;
+  const float* va = p_.key_values.data() + t.first_key;
   if (n < 2) {
     set_direct(n == 0 ? 0.0f : va[0], -kInf, kInf);
     return;
@@ -332,7 +323,7 @@ void Clip::refresh_cursor(uint32_t c, float f, SampleCursor& cursor) const noexc
   const float pm = va[j > 0 ? j - 1 : 0];
   const float p2 = va[j + 2 < n ? j + 2 : n - 1];
   float a0 = 1.0f, a1 = 1.0f;
-  if (rule_ == TangentRule::step_adjusted) {
+  if (p_.rule == TangentRule::step_adjusted) {
     const float len = static_cast<float>(fr[j + 1] - fr[j]);
     if (j > 0) a0 = 2.0f * len / (static_cast<float>(fr[j] - fr[j - 1]) + len);
     if (j + 2 < n) a1 = 2.0f * len / (len + static_cast<float>(fr[j + 2] - fr[j + 1]));
@@ -392,10 +383,10 @@ void Clip::sample_cursor(float f, float* out, SampleCursor& cursor) const noexce
 }
 
 float Clip::sample_channel(uint32_t c, float frame_position) const noexcept {
-  if (c >= tracks_.size()) return 0.0f;
-  const ChannelTrack& t = tracks_[c];
-  return eval_channel(key_frames_.data() + t.first_key, key_values_.data() + t.first_key, t.key_count,
-                      frame_position, t.interp, t.s, rule_);
+  if (c >= p_.tracks.size()) return 0.0f;
+  const ChannelTrack& t = p_.tracks[c];
+  return eval_channel(p_.key_frames.data() + t.first_key, p_.key_values.data() + t.first_key, t.key_count,
+                      frame_position, t.interp, t.s, p_.rule);
 }
 
 Status Clip::sample(double frame_position, std::span<float> out, SampleCursor* cursor) const noexcept {
@@ -430,7 +421,7 @@ Status Clip::sample(double frame_position, std::span<float> out, SampleCursor* c
 
 Status Clip::sample_time(double seconds, std::span<float> out, SampleCursor* cursor) const noexcept {
   if (std::isnan(seconds)) return Status::invalid_argument;
-  const double position = frame_time_ > 0.0 ? seconds / frame_time_ : 0.0;
+  const double position = p_.frame_time > 0.0 ? seconds / p_.frame_time : 0.0;
   return sample(position, out, cursor);
 }
 
@@ -439,7 +430,7 @@ Status Clip::sample_channels(double frame_position, std::span<const uint32_t> ch
   if (std::isnan(frame_position)) return Status::invalid_argument;
   if (out.size() < channels.size()) return Status::output_too_small;
   for (uint32_t c : channels)
-    if (c >= tracks_.size()) return Status::invalid_argument;
+    if (c >= p_.tracks.size()) return Status::invalid_argument;
   if (channels.size() > UINT32_MAX) return Status::invalid_argument;
   sample_batch(static_cast<float>(frame_position), channels.data(), static_cast<uint32_t>(channels.size()),
                out.data());
