@@ -2,12 +2,7 @@
 # CLI behaviour through the real binary: cli_test.sh KEYANIM DATA_DIR CASE
 # Each case prints what it checks and exits non-zero on the first surprise.
 set -uo pipefail
-K="$1"; DATA="$2"; CASE="$3"
-WALK="$DATA/cmu_02_01_walk.bvh"
-T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
-cd "$T"
-
-. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
 
 case "$CASE" in

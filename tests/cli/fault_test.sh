@@ -4,21 +4,12 @@
 # during directory runs. Each case prints what it checks and exits non-zero on the first
 # surprise; a case whose setup this machine does not allow (mount, mknod) says so and passes.
 set -uo pipefail
-K=$(realpath "$1"); DATA=$(realpath "$2"); CASE="$3"
-[ -x "$K" ] || { echo "FAIL: $K is not an executable" >&2; exit 1; }
-WALK="$DATA/cmu_02_01_walk.bvh"
-HOP="$DATA/cmu_131_03_hop.bvh"
-T=$(mktemp -d)
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 MOUNTS=()
-cleanup() {
+before_cleanup() {  # unmount what a case mounted before the scratch directory goes
   local m
   for m in "${MOUNTS[@]+"${MOUNTS[@]}"}"; do umount "$m" 2>/dev/null; done
-  rm -rf "$T"
 }
-trap cleanup EXIT
-cd "$T"
-
-. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 skip() { echo "skipped: $CASE: $*"; exit 0; }
 no_temps() {  # no_temps DIR: no temporary output left anywhere below DIR
   local left

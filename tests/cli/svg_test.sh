@@ -3,12 +3,7 @@
 # CASE plot|render: the figure is well-formed XML with its axes, labels, series and markers.
 # CASE exit_codes: usage errors, unreadable inputs and existing outputs.
 set -uo pipefail
-K="$1"; DATA="$2"; CASE="$3"
-WALK="$DATA/cmu_02_01_walk.bvh"
-T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
-cd "$T"
-
-. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 # Well-formed XML whose root is <svg> with a viewBox (python3 if present, else xmllint).
 well_formed() {
   if command -v python3 >/dev/null; then
