@@ -119,22 +119,29 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row) {
   return m;
 }
 
-void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out) {
-  // Per-thread scratch so that the encoder's per-frame calls allocate nothing after the first.
+namespace {
+
+// World positions into `out`, with a per-thread rotation scratch so that the encoder's
+// per-frame calls allocate nothing after the first.
+template <typename SinCos>
+void positions_with_scratch(const Skeleton& skeleton, const double* frame_row, SinCos sin_cos,
+                            std::vector<Vec3>& out) {
   thread_local std::vector<Mat3> rotations;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n);
   out.resize(n);
-  pose_frame(skeleton, frame_row, out.data(), rotations.data(), ComputeSinCos{});
+  pose_frame(skeleton, frame_row, out.data(), rotations.data(), sin_cos);
+}
+
+}  // namespace
+
+void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out) {
+  positions_with_scratch(skeleton, frame_row, ComputeSinCos{}, out);
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,
                      std::vector<Vec3>& out) {
-  thread_local std::vector<Mat3> rotations;
-  const size_t n = skeleton.joints.size();
-  if (rotations.size() < n) rotations.resize(n);
-  out.resize(n);
-  pose_frame(skeleton, frame_row, out.data(), rotations.data(), GivenSinCos{sines, cosines});
+  positions_with_scratch(skeleton, frame_row, GivenSinCos{sines, cosines}, out);
 }
 
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
