@@ -15,6 +15,13 @@ inline void put_varint(std::vector<uint8_t>& out, uint64_t v) {
   out.push_back(static_cast<uint8_t>(v));
 }
 
+// Bytes put_varint writes for v.
+inline size_t varint_size(uint64_t v) noexcept {
+  size_t n = 1;
+  for (; v >= 0x80; v >>= 7) ++n;
+  return n;
+}
+
 inline uint64_t zigzag_encode(int64_t d) noexcept {
   return (static_cast<uint64_t>(d) << 1) ^ static_cast<uint64_t>(d >> 63);
 }

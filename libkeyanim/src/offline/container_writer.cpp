@@ -39,8 +39,7 @@ bool residuals(const EncodedChannel& c, ValueCoding coding, std::vector<int64_t>
 
 size_t varint_bytes(const std::vector<int64_t>& r) {
   size_t n = 0;
-  for (int64_t x : r)
-    for (uint64_t u = internal::zigzag_encode(x); ; u >>= 7) { ++n; if (u < 128) break; }
+  for (int64_t x : r) n += internal::varint_size(internal::zigzag_encode(x));
   return n;
 }
 
