@@ -116,7 +116,7 @@ void decode_channel(const EncodedChannel& ch, TangentRule rule, std::vector<floa
   for (uint32_t f = 0; f < frames; ++f) {
     if (n == 1 || f <= k[0]) { out[f] = v[0]; continue; }
     if (f >= k[n - 1]) { out[f] = v[n - 1]; continue; }
-    if (k[j + 1] <= f || f == k[0] + 1) {
+    if (k[j + 1] <= f || f == k[0] + 1) {  // a new segment, or the first one
       while (k[j + 1] <= f) ++j;
       ops = segment_operands(k, v.data(), n, j, ch.interp, s, rule);
     }
