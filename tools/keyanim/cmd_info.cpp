@@ -80,13 +80,13 @@ int cmd_info(const Argv& argv, Globals& g) {
     double t_sum = 0.0;
     uint32_t curved = 0;
     for (uint32_t c = 0; c < clip.channel_count(); ++c) {
-      const ChannelTrack& t = clip.track(c);
+      const ChannelInfo t = clip.channel(c);
       keys.push_back(t.key_count);
       zero += t.key_count == 0;
       constant += t.key_count == 1;
       if (t.key_count < 2) continue;
       if (t.interp == Interpolation::linear) { ++linear; continue; }
-      const float tension = s_to_tension(t.s);
+      const float tension = t.tension;
       t_min = std::min(t_min, tension), t_max = std::max(t_max, tension), t_sum += tension, ++curved;
     }
     std::sort(keys.begin(), keys.end());

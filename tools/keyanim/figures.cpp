@@ -109,8 +109,10 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   const bool rotation = is_rotation(type);
   const uint32_t n = motion.frame_count, first = range.first, last = std::min(range.last, n - 1);
   std::vector<double> original = motion.channel(channel);
-  const std::span<const uint32_t> key_frames = clip.key_frames(channel);
-  const std::span<const float> key_values = clip.key_values(channel);
+  const uint32_t key_count = clip.channel(channel).key_count;
+  std::vector<uint32_t> key_frames(key_count);
+  std::vector<float> key_values(key_count);
+  clip.channel_keys(channel, key_frames, key_values);
   // An angle and the same angle +-360 are one pose; show both curves on one branch.
   double shift = 0.0;
   if (rotation) {

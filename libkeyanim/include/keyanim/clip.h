@@ -21,6 +21,13 @@ struct DecodeLimits {
   uint64_t max_decompressed_bytes = 1ull << 30;  // Defaults to 1 GiB of decompressed sections.
 };
 
+// What a channel is, independent of how a loaded clip stores it.
+struct ChannelInfo {
+  Interpolation interp = Interpolation::cardinal;
+  float tension = 0.0f;    // T in [-1, 1] (s = (1 - T) / 2); ignored by linear channels
+  uint32_t key_count = 0;  // 0: all zeros; 1: constant
+};
+
 // One channel's keys, as the sampler sees them.
 struct ChannelTrack {
   uint32_t first_key = 0;  // index into Clip's key arrays
@@ -68,6 +75,12 @@ class Clip {
   TangentRule tangent_rule() const noexcept { return p_.rule; }
   const Skeleton& skeleton() const noexcept { return p_.skeleton; }
   const ChannelTrack& track(uint32_t c) const noexcept { return p_.tracks[c]; }
+  // Channel c (< channel_count()): interpolation, tension and number of keys.
+  ChannelInfo channel(uint32_t c) const noexcept;
+  // Channel c's keys: frames (strictly increasing) and values, exactly as the sampler uses them.
+  // Both spans must hold channel(c).key_count entries (output_too_small); c >= channel_count()
+  // is invalid_argument.
+  Status channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<float> values) const noexcept;
   std::span<const uint32_t> key_frames(uint32_t c) const noexcept;
   std::span<const float> key_values(uint32_t c) const noexcept;
   uint64_t total_keys() const noexcept { return p_.key_frames.size(); }

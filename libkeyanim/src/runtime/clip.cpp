@@ -94,6 +94,20 @@ std::span<const float> Clip::key_values(uint32_t c) const noexcept {
   return {p_.key_values.data() + t.first_key, t.key_count};
 }
 
+ChannelInfo Clip::channel(uint32_t c) const noexcept {
+  const ChannelTrack& t = p_.tracks[c];
+  return {t.interp, s_to_tension(t.s), t.key_count};
+}
+
+Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<float> values) const noexcept {
+  if (c >= p_.tracks.size()) return Status::invalid_argument;
+  const ChannelTrack& t = p_.tracks[c];
+  if (frames.size() < t.key_count || values.size() < t.key_count) return Status::output_too_small;
+  std::copy_n(p_.key_frames.data() + t.first_key, t.key_count, frames.data());
+  std::copy_n(p_.key_values.data() + t.first_key, t.key_count, values.data());
+  return Status::ok;
+}
+
 size_t Clip::memory_bytes() const noexcept {
   size_t n = sizeof(Clip);
   n += p_.tracks.capacity() * sizeof(ChannelTrack);
