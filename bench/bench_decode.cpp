@@ -188,7 +188,8 @@ nlohmann::json measure(const EncodedClip& e, const Motion& m) {
   }
   std::vector<float> out(C);
   std::vector<double> random_ns, seq_ns, copy_random_ns, copy_seq_ns;
-  keyanim::SampleCursor cursor;
+  keyanim::Cursor cursor;
+  cursor.prepare(clip);
   for (int r = 0; r < 11; ++r) {
     copy_random_ns.push_back(time_ns([&] {
       for (size_t i = 0; i < poses; ++i) {
@@ -218,23 +219,6 @@ nlohmann::json measure(const EncodedClip& e, const Motion& m) {
   const double rnd = median(random_ns), seq = median(seq_ns), crnd = median(copy_random_ns),
                cseq = median(copy_seq_ns);
 
-  // Without the segment index, for comparison: plain eval_channel (binary search per channel).
-  std::vector<double> bsearch_ns;
-  for (int r = 0; r < 3; ++r) {
-    bsearch_ns.push_back(time_ns([&] {
-      for (size_t i = 0; i < poses / 4; ++i) {
-        const float f = float(positions[i]);
-        for (uint32_t c = 0; c < C; ++c) {
-          const auto fr = clip.key_frames(c);
-          const auto va = clip.key_values(c);
-          out[c] = keyanim::eval_channel(fr.data(), va.data(), uint32_t(fr.size()), f, clip.track(c).interp,
-                                         clip.track(c).s, clip.tangent_rule());
-        }
-        g_sink = g_sink + out[i % C];
-      }
-    }) / double(poses / 4));
-  }
-
   j["frames"] = F;
   j["channels"] = C;
   j["keys"] = clip.total_keys();
@@ -250,7 +234,6 @@ nlohmann::json measure(const EncodedClip& e, const Motion& m) {
   j["key_array_bytes"] = uint64_t(key_array_bytes);
   j["memory_over_key_arrays"] = double(clip.memory_bytes()) / key_array_bytes;
   j["random_pose_ns"] = rnd;
-  j["random_pose_ns_binary_search_only"] = median(bsearch_ns);
   j["sequential_cursor_pose_ns"] = seq;
   j["raw_copy_random_pose_ns"] = crnd;
   j["raw_copy_sequential_pose_ns"] = cseq;

@@ -14,6 +14,7 @@
 
 #include "fuzz_common.h"
 #include "keyanim/clip.h"
+#include "clip_reference.h"
 #include "keyanim/version.h"
 
 namespace {
@@ -42,22 +43,21 @@ void check_loaded(const Clip& clip) {
     if (joints[i].end_site) FUZZ_CHECK(joints[i].channels.empty() && joints[i].parent >= 0);
     for (double o : joints[i].offset) FUZZ_CHECK(std::isfinite(o));
   }
-  uint64_t expected_first = 0;
+  uint64_t keys = 0;
   for (uint32_t c = 0; c < channels; ++c) {
-    const keyanim::ChannelTrack& t = clip.track(c);
-    FUZZ_CHECK(t.first_key == expected_first);
-    FUZZ_CHECK(t.key_count <= clip.frame_count());
-    FUZZ_CHECK(std::isfinite(t.s));
-    expected_first += t.key_count;
-    const auto frames = clip.key_frames(c);
-    const auto values = clip.key_values(c);
-    for (size_t i = 0; i < frames.size(); ++i) {
-      FUZZ_CHECK(frames[i] < clip.frame_count());
-      if (i > 0) FUZZ_CHECK(frames[i] > frames[i - 1]);
-      FUZZ_CHECK(std::isfinite(values[i]));
+    const keyanim::ChannelInfo info = clip.channel(c);
+    FUZZ_CHECK(info.key_count <= clip.frame_count());
+    FUZZ_CHECK(std::isfinite(info.tension) && info.tension >= -1.0f && info.tension <= 1.0f);
+    keys += info.key_count;
+    const keyanim::test::ChannelKeys k = keyanim::test::channel_keys(clip, c);
+    FUZZ_CHECK(k.frames.size() == info.key_count);
+    for (size_t i = 0; i < k.frames.size(); ++i) {
+      FUZZ_CHECK(k.frames[i] < clip.frame_count());
+      if (i > 0) FUZZ_CHECK(k.frames[i] > k.frames[i - 1]);
+      FUZZ_CHECK(std::isfinite(k.values[i]));
     }
   }
-  FUZZ_CHECK(expected_first == clip.total_keys());
+  FUZZ_CHECK(keys == clip.total_keys());
   // The sampler on the clip just loaded: one pose at its first and last frame.
   std::vector<float> pose(channels);
   FUZZ_CHECK(clip.sample(0.0, pose) == Status::ok);

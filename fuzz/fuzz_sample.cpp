@@ -19,6 +19,7 @@
 #include "fuzz_common.h"
 #include "keyanim/cardinal.h"
 #include "keyanim/clip.h"
+#include "clip_reference.h"
 
 namespace {
 
@@ -31,11 +32,10 @@ constexpr size_t kRecord = 9;
 // came back from the cursor path as +0 at its own key frame).
 bool same_value(float a, float b) { return keyanim::fuzz::same_float(a, b); }
 
-float reference(const Clip& clip, uint32_t c, float f) {
-  const keyanim::ChannelTrack& t = clip.track(c);
-  return keyanim::eval_channel(clip.key_frames(c).data(), clip.key_values(c).data(), t.key_count, f, t.interp, t.s,
-                               clip.tangent_rule());
-}
+// The clip's keys, read once per input: the reference evaluates them with eval_channel.
+std::vector<keyanim::test::ChannelKeys> g_keys;
+
+float reference(const Clip& clip, uint32_t c, float f) { return keyanim::test::reference_value(clip, g_keys[c], f); }
 
 // A position from the mode's upper bits and the payload.
 double make_position(const Clip& clip, uint8_t mode, const uint8_t* payload) {
@@ -56,7 +56,7 @@ double make_position(const Clip& clip, uint8_t mode, const uint8_t* payload) {
     case 4: {  // a key frame of some channel, or a float neighbour of it
       if (clip.total_keys() == 0) return 0.0;
       const uint32_t c = hi % clip.channel_count();
-      const auto keys = clip.key_frames(c);
+      const auto& keys = g_keys[c].frames;
       if (keys.empty()) return 0.0;
       const float k = static_cast<float>(keys[lo % keys.size()]);
       const int side = static_cast<int>((lo >> 24) % 3);
@@ -95,10 +95,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   limits.max_channels = 4096;
   Clip clip;
   if (Clip::load(file, clip, nullptr, limits) != Status::ok) return 0;
-  const Clip other = clip;  // same content at another address: a cursor must notice the switch
+  const Clip other = clip;  // a copy shares the image, and so the cursor
   const uint32_t channels = clip.channel_count();
   std::vector<float> pose(channels), pose2(channels);
-  keyanim::SampleCursor cursor;
+  g_keys = keyanim::test::all_channel_keys(clip);
+  keyanim::Cursor cursor;
+  if (cursor.prepare(clip) != Status::ok) return 0;
 
   for (size_t r = 0; r < n; ++r) {
     const uint8_t mode = records[r * kRecord];
@@ -108,7 +110,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const double position = by_time ? (clip.frame_time() > 0.0 ? x / clip.frame_time() : 0.0) : x;
     const float f = static_cast<float>(position);
     // The request at x, by frame position or by time.
-    auto call = [&](const Clip& c, std::vector<float>& out, keyanim::SampleCursor* cur) {
+    auto call = [&](const Clip& c, std::vector<float>& out, keyanim::Cursor* cur) {
       return by_time ? c.sample_time(x, out, cur) : c.sample(x, out, cur);
     };
     Status s;

@@ -8,6 +8,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -24,6 +25,7 @@
 
 #include "keyanim/cardinal.h"
 #include "keyanim/clip.h"
+#include "clip_reference.h"
 #include "keyanim/version.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
@@ -285,15 +287,13 @@ void check_same_clip(const Clip& a, const Clip& b) {
     CHECK(x.first_channel == y.first_channel);
   }
   for (uint32_t c = 0; c < a.channel_count(); ++c) {
-    CHECK(a.track(c).first_key == b.track(c).first_key);
-    CHECK(a.track(c).key_count == b.track(c).key_count);
-    CHECK(a.track(c).interp == b.track(c).interp);
-    CHECK(same_bits(a.track(c).s, b.track(c).s));
-    const auto fa = a.key_frames(c), fb = b.key_frames(c);
-    CHECK(std::equal(fa.begin(), fa.end(), fb.begin(), fb.end()));
-    const auto va = a.key_values(c), vb = b.key_values(c);
-    REQUIRE(va.size() == vb.size());
-    for (size_t k = 0; k < va.size(); ++k) CHECK(same_bits(va[k], vb[k]));
+    CHECK(a.channel(c).key_count == b.channel(c).key_count);
+    CHECK(a.channel(c).interp == b.channel(c).interp);
+    CHECK(same_bits(a.channel(c).tension, b.channel(c).tension));
+    const keyanim::test::ChannelKeys ka = keyanim::test::channel_keys(a, c), kb = keyanim::test::channel_keys(b, c);
+    CHECK(ka.frames == kb.frames);
+    REQUIRE(ka.values.size() == kb.values.size());
+    for (size_t k = 0; k < ka.values.size(); ++k) CHECK(same_bits(ka.values[k], kb.values[k]));
   }
 }
 
@@ -302,7 +302,9 @@ void check_same_clip(const Clip& a, const Clip& b) {
 void check_same_samples(const Clip& a, const Clip& b) {
   const uint32_t n = a.channel_count();
   std::vector<float> sa(n), sb(n);
-  keyanim::SampleCursor cursor;
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(b) == Status::ok);
+  const auto keys = keyanim::test::all_channel_keys(a);
   uint64_t mismatches = 0, eval_mismatches = 0;
   const double end = double(a.frame_count()) + 1.0;
   for (double x = -2.0; x <= end; x += 0.25) {
@@ -310,11 +312,7 @@ void check_same_samples(const Clip& a, const Clip& b) {
     REQUIRE(b.sample(x, sb, &cursor) == Status::ok);
     for (uint32_t c = 0; c < n; ++c) {
       if (!same_bits(sa[c], sb[c])) ++mismatches;
-      const auto fr = a.key_frames(c);
-      const auto va = a.key_values(c);
-      const float ref = keyanim::eval_channel(fr.data(), va.data(), uint32_t(fr.size()), float(x),
-                                              a.track(c).interp, a.track(c).s, a.tangent_rule());
-      if (!same_bits(sa[c], ref)) ++eval_mismatches;
+      if (!same_bits(sa[c], keyanim::test::reference_value(a, keys[c], float(x)))) ++eval_mismatches;
     }
   }
   CHECK(mismatches == 0);
@@ -609,9 +607,11 @@ TEST_CASE("key values are dequantized as float of q times step in double") {
   const Loaded l = load(keyanim::offline::write_kanim(e));
   REQUIRE(l.status == Status::ok);
   // Channel 11: q = 123456 and -654321 at step 1e-3, computed in double then rounded.
-  CHECK(l.clip.key_values(11)[0] == float(123456 * 1e-3));
-  CHECK(l.clip.key_values(11)[1] == float(-654321 * 1e-3));
-  CHECK(l.clip.key_values(2).empty());
+  const keyanim::test::ChannelKeys k11 = keyanim::test::channel_keys(l.clip, 11);
+  REQUIRE(k11.values.size() == 2);
+  CHECK(k11.values[0] == float(123456 * 1e-3));
+  CHECK(k11.values[1] == float(-654321 * 1e-3));
+  CHECK(keyanim::test::channel_keys(l.clip, 2).values.empty());
   CHECK(l.clip.sample_channel(2, 7.5f) == 0.0f);
   CHECK(l.clip.sample_channel(3, 0.0f) == float(123 * 0.1));  // a constant before its key
 }
@@ -622,28 +622,38 @@ TEST_CASE("the cursor never changes a result") {
   const Clip other = keyanim::offline::to_clip(random_clip(8, 50, 2));
   const uint32_t n = clip.channel_count();
   std::vector<float> a(n), b(n), o(other.channel_count());
-  keyanim::SampleCursor cursor;
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  CHECK(cursor.prepared_for(clip));
+  CHECK(!cursor.prepared_for(other));
   uint64_t s = 99, mismatches = 0;
   for (int i = 0; i < 3000; ++i) {
-    // Forward steps, backward jumps, far jumps, and a second clip sharing the cursor.
+    // Forward steps, backward jumps, far jumps; a second clip refuses the cursor.
     double x = i < 1000 ? i * 0.37 : i < 2000 ? 400.0 - (i - 1000) * 0.41 : double(lcg(s) % 40000) / 97.0;
-    if (i % 500 == 0) REQUIRE(other.sample(x, o, &cursor) == Status::ok);
-    if (i == 2500) std::fill(cursor.segment.begin(), cursor.segment.end(), 123456u);  // garbage
+    if (i % 500 == 0) REQUIRE(other.sample(x, o, &cursor) == Status::invalid_argument);
+    if (i == 2500) REQUIRE(cursor.prepare(clip) == Status::ok);  // a fresh state mid-way
     REQUIRE(clip.sample(x, a) == Status::ok);
     REQUIRE(clip.sample(x, b, &cursor) == Status::ok);
     for (uint32_t c = 0; c < n; ++c) mismatches += !same_bits(a[c], b[c]);
   }
   CHECK(mismatches == 0);
-  CHECK(cursor.clip == &clip);
-
-  // A new clip at the address of a destroyed one is still a different clip for the cursor.
+  // A copy of the clip shares its image, and the cursor.
+  const Clip copy = clip;
+  CHECK(cursor.prepared_for(copy));
+  // An unprepared cursor is refused, and a new clip at the address of a destroyed one is a
+  // different clip for the cursor.
+  keyanim::Cursor none;
+  CHECK(clip.sample(1.0, a, &none) == Status::invalid_argument);
   std::optional<Clip> slot;
   slot.emplace(keyanim::offline::to_clip(random_clip(21, 300, 4)));
   std::vector<float> x(slot->channel_count()), y(slot->channel_count());
-  keyanim::SampleCursor reused;
+  keyanim::Cursor reused;
+  REQUIRE(reused.prepare(*slot) == Status::ok);
   REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
   slot.emplace(keyanim::offline::to_clip(random_clip(22, 300, 4)));
   REQUIRE(slot->channel_count() == x.size());
+  CHECK(slot->sample(150.5, x, &reused) == Status::invalid_argument);
+  REQUIRE(reused.prepare(*slot) == Status::ok);
   REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
   REQUIRE(slot->sample(150.5, y) == Status::ok);
   for (size_t c = 0; c < x.size(); ++c) CHECK(same_bits(x[c], y[c]));
@@ -679,14 +689,21 @@ TEST_CASE("sample_time sample_channels and argument errors") {
   CHECK(single.duration() == 0.0);
 }
 
-TEST_CASE("memory stays within 1.5 times the key arrays plus the tracks and skeleton") {
+TEST_CASE("a loaded clip holds its keys bit-packed, not expanded") {
   for (uint64_t seed : {11u, 12u, 13u}) {
-    const Clip clip = keyanim::offline::to_clip(random_clip(seed, 2000, 12));
-    const size_t keys = clip.total_keys() * 8;
-    const size_t fixed = sizeof(Clip) + clip.channel_count() * sizeof(keyanim::ChannelTrack) +
-                         clip.skeleton().joints.size() * (sizeof(Joint) + 64);
-    CHECK(clip.memory_bytes() <= keys + keys / 2 + fixed);  // the index is at most half the keys
-    CHECK(clip.memory_bytes() >= keys);
+    const EncodedClip e = random_clip(seed, 2000, 12);
+    const Clip clip = keyanim::offline::to_clip(e);
+    // Each key costs its value's bits in at most two records (its block's, and as context of
+    // a neighbouring block), plus per-record headers; expanded arrays cost 8 bytes a key.
+    uint64_t value_bits = 0;
+    for (const auto& ch : e.channels) {
+      if (ch.q.size() < 2) continue;
+      const auto [lo, hi] = std::minmax_element(ch.q.begin(), ch.q.end());
+      value_bits += 3 * ch.q.size() * std::bit_width(uint64_t(*hi - *lo));
+    }
+    const size_t records = e.channels.size() * ((e.frame_count + 63) / 64);
+    CHECK(clip.memory_bytes() <= value_bits / 8 + records * 40 + 16384);
+    CHECK(clip.memory_bytes() < clip.total_keys() * 8);
   }
 }
 

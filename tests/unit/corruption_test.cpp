@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "clip_reference.h"
 #include "keyanim/version.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
@@ -361,11 +362,12 @@ TEST_CASE("test vectors: damage behind a repaired checksum never crashes") {
         if (Clip::load(f, clip) != Status::ok) continue;
         ++loaded;
         for (uint32_t c = 0; c < clip.channel_count(); ++c) {
-          const auto frames = clip.key_frames(c);
-          for (size_t k = 0; k < frames.size(); ++k) {
-            REQUIRE(frames[k] < clip.frame_count());
-            if (k > 0) REQUIRE(frames[k] > frames[k - 1]);
-            REQUIRE(std::isfinite(clip.key_values(c)[k]));
+          const keyanim::test::ChannelKeys keys = keyanim::test::channel_keys(clip, c);
+          REQUIRE(keys.frames.size() == clip.channel(c).key_count);
+          for (size_t k = 0; k < keys.frames.size(); ++k) {
+            REQUIRE(keys.frames[k] < clip.frame_count());
+            if (k > 0) REQUIRE(keys.frames[k] > keys.frames[k - 1]);
+            REQUIRE(std::isfinite(keys.values[k]));
           }
         }
         std::vector<float> pose(clip.channel_count());

@@ -16,6 +16,8 @@
 #include "internal/varint.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/version.h"
+#include "runtime/clip_access.h"
+#include "internal/clip_source.h"
 
 namespace keyanim::offline {
 namespace {
@@ -250,6 +252,7 @@ std::string validate_encoded_clip(const EncodedClip& clip) {
   }
   if (channel_sum != clip.channels.size()) return "channel count differs from the skeleton's";
   if (static_cast<uint8_t>(clip.tangent_rule) > internal::kMaxTangentRule) return "unknown tangent rule";
+  if (clip.frame_count > internal::kMaxFrames) return "more than 2^24 frames";
   if (!std::isfinite(clip.frame_time) || clip.frame_time < 0.0 ||
       (clip.frame_count > 1 && !(clip.frame_time > 0.0)))
     return "frame_time must be finite, >= 0, and > 0 when there are several frames";
@@ -312,31 +315,28 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
 }
 
 Clip to_clip(const EncodedClip& clip) {
-  Clip::Parts p;
-  p.version_major = kFormatVersionMajor;
-  p.version_minor = kFormatVersionMinor;
-  p.frame_count = clip.frame_count;
-  p.frame_time = clip.frame_time;
-  p.rule = clip.tangent_rule;
-  p.skeleton = clip.skeleton;
-  p.skeleton.assign_channel_columns();
-  size_t keys = 0;
-  for (const auto& c : clip.channels) keys += c.frames.size();
-  p.tracks.reserve(clip.channels.size());
-  p.key_frames.reserve(keys);
-  p.key_values.reserve(keys);
+  internal::ClipSource src;
+  src.version_major = kFormatVersionMajor;
+  src.version_minor = kFormatVersionMinor;
+  src.frame_count = clip.frame_count;
+  src.frame_time = clip.frame_time;
+  src.rule = clip.tangent_rule;
+  src.skeleton = clip.skeleton;
+  src.skeleton.assign_channel_columns();
+  src.channels.reserve(clip.channels.size());
   for (const auto& c : clip.channels) {
-    ChannelTrack t;
-    t.first_key = static_cast<uint32_t>(p.key_frames.size());
-    t.key_count = static_cast<uint32_t>(c.frames.size());
-    t.interp = c.interp;
-    t.s = tension_to_s(c.tension);
-    p.tracks.push_back(t);
-    p.key_frames.insert(p.key_frames.end(), c.frames.begin(), c.frames.end());
-    for (int64_t q : c.q) p.key_values.push_back(dequantize(q, c.step));
+    internal::SourceChannel sc;
+    sc.interp = c.interp;
+    sc.tension = c.tension;
+    sc.step = c.step;
+    sc.first_key = src.frames.size();
+    sc.key_count = static_cast<uint32_t>(c.frames.size());
+    src.channels.push_back(sc);
+    src.frames.insert(src.frames.end(), c.frames.begin(), c.frames.end());
+    src.q.insert(src.q.end(), c.q.begin(), c.q.end());
   }
-  p.notes = clip.notes;
-  return Clip::from_parts(std::move(p));
+  src.notes = clip.notes;
+  return ClipAccess::make(internal::build_image(std::move(src)));
 }
 
 }  // namespace keyanim::offline

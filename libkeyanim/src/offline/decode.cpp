@@ -83,7 +83,8 @@ bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out
   m.frame_time = frame_time;
   m.values.resize(static_cast<size_t>(count) * channels);
   std::vector<float> pose(channels);
-  SampleCursor cursor;
+  Cursor cursor;
+  if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
   const double per = static_cast<double>(options.inbetweens) + 1.0;
   for (uint64_t i = 0; i < count; ++i) {
     double position;

@@ -93,7 +93,8 @@ void decode_all(const Clip& clip, Motion& out) {
   const uint32_t n = clip.channel_count();
   out.values.assign(size_t(clip.frame_count()) * n, 0.0);
   std::vector<float> row(n);
-  SampleCursor cursor;
+  Cursor cursor;
+  if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
   for (uint32_t f = 0; f < clip.frame_count(); ++f) {
     clip.sample(double(f), row, &cursor);
     for (uint32_t c = 0; c < n; ++c) out.values[size_t(f) * n + c] = row[c];

@@ -20,13 +20,17 @@
 #include "internal/value_coding.h"
 #include "internal/zstd_bound.h"
 #include "internal/varint.h"
+#include "internal/clip_source.h"
 #include "keyanim/clip.h"
 #include "keyanim/version.h"
+#include "runtime/clip_access.h"
+#include "runtime/image.h"
 
 namespace keyanim {
 namespace {
 
 using internal::ByteReader;
+using internal::ClipSource;
 
 std::string tag_name(uint32_t tag) {
   std::string s(4, '?');
@@ -64,7 +68,7 @@ class Loader {
   Loader(std::span<const uint8_t> bytes, const DecodeLimits& limits, ErrorInfo* err)
       : bytes_(bytes), limits_(limits), err_(err) {}
 
-  Status run(Clip::Parts& parts);
+  Status run(ClipSource& parts);
 
  private:
   Status fail(Status s, const char* section, uint64_t offset, std::string detail) {
@@ -86,11 +90,11 @@ class Loader {
 
   Status read_header_and_table();
   Status get_content(const TableEntry& e, const char* name, Content& out);
-  Status parse_clip(const Content& c, Clip::Parts& parts);
-  Status parse_skel(const Content& c, Clip::Parts& parts);
-  Status parse_chan(const Content& c, Clip::Parts& parts);
-  Status parse_ktim(const Content& c, Clip::Parts& parts);
-  Status parse_kval(const Content& c, Clip::Parts& parts);
+  Status parse_clip(const Content& c, ClipSource& parts);
+  Status parse_skel(const Content& c, ClipSource& parts);
+  Status parse_chan(const Content& c, ClipSource& parts);
+  Status parse_ktim(const Content& c, ClipSource& parts);
+  Status parse_kval(const Content& c, ClipSource& parts);
 
   std::span<const uint8_t> bytes_;
   const DecodeLimits& limits_;
@@ -111,7 +115,6 @@ class Loader {
   uint32_t node_count_ = 0;
   uint32_t channel_count_ = 0;
   // From CHAN, needed by KVAL.
-  std::vector<double> steps_;
   std::vector<internal::ValueCoding> codings_;  // all delta in 1.x
 };
 
@@ -266,7 +269,7 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out) 
   return Status::ok;
 }
 
-Status Loader::parse_clip(const Content& c, Clip::Parts& parts) {
+Status Loader::parse_clip(const Content& c, ClipSource& parts) {
   if (c.size != internal::kClipSize)
     return fail_in(Status::corrupt, c, 0, "CLIP must be 32 bytes, not " + std::to_string(c.size));
   ByteReader r(c.data, c.size);
@@ -282,7 +285,7 @@ Status Loader::parse_clip(const Content& c, Clip::Parts& parts) {
   r.read(reserved);
   r.read(frame_time);
   r.read(key_count_);
-  if (frames > limits_.max_frames)
+  if (frames > std::min(limits_.max_frames, internal::kMaxFrames))
     return fail_in(Status::limit_exceeded, c, 0, "Frame_Count " + std::to_string(frames) + " exceeds the limit");
   if (node_count_ > limits_.max_joints)
     return fail_in(Status::limit_exceeded, c, 4, "Node_Count " + std::to_string(node_count_) + " exceeds the limit");
@@ -306,7 +309,7 @@ Status Loader::parse_clip(const Content& c, Clip::Parts& parts) {
   return Status::ok;
 }
 
-Status Loader::parse_skel(const Content& c, Clip::Parts& parts) {
+Status Loader::parse_skel(const Content& c, ClipSource& parts) {
   if (node_count_ > c.size / internal::kNodeFixedBytes)
     return fail_in(Status::corrupt, c, 0,
                    "SKEL is too short for " + std::to_string(node_count_) + " nodes");
@@ -365,14 +368,13 @@ Status Loader::parse_skel(const Content& c, Clip::Parts& parts) {
   return Status::ok;
 }
 
-Status Loader::parse_chan(const Content& c, Clip::Parts& parts) {
+Status Loader::parse_chan(const Content& c, ClipSource& parts) {
   const uint64_t channels = channel_count_;
   const size_t per_channel = major_ >= 2 ? internal::kChanBytesPerChannel : internal::kChanBytesPerChannelV1;
   if (c.size != channels * per_channel)
     return fail_in(Status::corrupt, c, 0, "CHAN must be " + std::to_string(per_channel) + " x Channel_Count bytes");
   const uint8_t* p = c.data;
-  parts.tracks.resize(channels);
-  steps_.resize(channels);
+  parts.channels.resize(channels);
   codings_.assign(channels, internal::ValueCoding::delta);
   uint64_t key_sum = 0;
   for (uint64_t i = 0; i < channels; ++i) {
@@ -397,12 +399,12 @@ Status Loader::parse_chan(const Content& c, Clip::Parts& parts) {
         return fail_in(Status::reserved_bits_set, c, at_coding, ch + "reserved Value_Coding " + std::to_string(p[at_coding]));
       codings_[i] = static_cast<internal::ValueCoding>(p[at_coding]);
     }
-    ChannelTrack& t = parts.tracks[i];
-    t.first_key = static_cast<uint32_t>(key_sum);  // key_sum <= Key_Count < 2^32 checked below
+    internal::SourceChannel& t = parts.channels[i];
+    t.first_key = key_sum;
     t.key_count = count;
     t.interp = static_cast<Interpolation>(interp);
-    t.s = tension_to_s(tension);
-    steps_[i] = step;
+    t.tension = tension;
+    t.step = step;
     key_sum += count;
     if (key_sum > key_count_)
       return fail_in(Status::corrupt, c, at_count, ch + "the channels' Key_Count add up to more than CLIP's");
@@ -422,14 +424,14 @@ const char* varint_problem(internal::VarintError e) {
   return "";
 }
 
-Status Loader::parse_ktim(const Content& c, Clip::Parts& parts) {
+Status Loader::parse_ktim(const Content& c, ClipSource& parts) {
   if (key_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KTIM is too short for Key_Count varints");
-  parts.key_frames.resize(static_cast<size_t>(key_count_));
-  uint32_t* out = parts.key_frames.data();
+  parts.frames.resize(static_cast<size_t>(key_count_));
+  uint32_t* out = parts.frames.data();
   const uint64_t frames = parts.frame_count;
   size_t pos = 0;
-  for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
-    const ChannelTrack& t = parts.tracks[ch];
+  for (size_t ch = 0; ch < parts.channels.size(); ++ch) {
+    const internal::SourceChannel& t = parts.channels[ch];
     uint64_t frame = 0;
     for (uint32_t i = 0; i < t.key_count; ++i) {
       const size_t at = pos;
@@ -451,7 +453,7 @@ Status Loader::parse_ktim(const Content& c, Clip::Parts& parts) {
   return Status::ok;
 }
 
-Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
+Status Loader::parse_kval(const Content& c, ClipSource& parts) {
   // Plane_Count, Plane_Size[Plane_Count], then the planes (spec/FORMAT.md 4.5).
   ByteReader r(c.data, c.size);
   uint8_t count = 0;
@@ -480,14 +482,14 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
     plane[k] = c.data + at;
     at += static_cast<size_t>(size[k]);
   }
-  parts.key_values.resize(static_cast<size_t>(key_count_));  // key_count_ == size[0] <= c.size
-  float* out = parts.key_values.data();
+  parts.q.resize(static_cast<size_t>(key_count_));  // key_count_ == size[0] <= c.size
+  int64_t* out = parts.q.data();
   size_t pos[internal::kMaxVarint64Bytes] = {};
-  for (size_t ch = 0; ch < parts.tracks.size(); ++ch) {
-    const ChannelTrack& t = parts.tracks[ch];
-    const double step = steps_[ch];
+  for (size_t ch = 0; ch < parts.channels.size(); ++ch) {
+    const internal::SourceChannel& t = parts.channels[ch];
+    const double step = t.step;
     const internal::ValueCoding coding = codings_[ch];
-    const uint32_t* kf = parts.key_frames.data() + t.first_key;  // KTIM is parsed before KVAL
+    const uint32_t* kf = parts.frames.data() + t.first_key;  // KTIM is parsed before KVAL
     // 1.x stores deltas up to 2^54; 2.x residuals up to 2^57, so |prediction + residual| < 2^58.
     const uint64_t max_residual = major_ >= 2 ? internal::kMaxAbsResidual : internal::kMaxAbsDelta;
     int64_t q = 0, q_prev = 0;
@@ -525,7 +527,7 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
       const float value = dequantize(q, step);
       if (!std::isfinite(value))
         return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": a key value is not finite");
-      out[t.first_key + i] = value;
+      out[t.first_key + i] = q;
     }
   }
   for (uint8_t k = 0; k < count; ++k)
@@ -533,7 +535,7 @@ Status Loader::parse_kval(const Content& c, Clip::Parts& parts) {
   return Status::ok;
 }
 
-Status Loader::run(Clip::Parts& parts) {
+Status Loader::run(ClipSource& parts) {
   Status s = read_header_and_table();
   if (s != Status::ok) return s;
   parts.version_major = major_;
@@ -570,11 +572,11 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
   out = Clip{};
   if (err != nullptr) *err = ErrorInfo{};
   try {
-    Clip::Parts parts;
+    ClipSource parts;
     Loader loader(bytes, limits, err);
     const Status s = loader.run(parts);
     if (s != Status::ok) return s;
-    out = Clip::from_parts(std::move(parts));
+    out = ClipAccess::make(internal::build_image(std::move(parts)));
   } catch (const std::bad_alloc&) {
     out = Clip{};
     if (err != nullptr) {

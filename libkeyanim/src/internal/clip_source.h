@@ -1,0 +1,38 @@
+// A clip's keys as integers, the way a file stores them: what the loader decodes from any
+// format version and what the encoder produces, before the runtime image is built from it
+// (runtime/image.h). Internal: nothing here is validated by its type; whoever fills it (the
+// loader, or offline::to_clip for an encoder's valid output) has checked every rule.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "keyanim/cardinal.h"
+#include "keyanim/skeleton.h"
+
+namespace keyanim::internal {
+
+struct SourceChannel {
+  Interpolation interp = Interpolation::cardinal;
+  float tension = 0.0f;
+  double step = 1.0;        // key value = dequantize(q, step)
+  uint64_t first_key = 0;   // into ClipSource::frames / q
+  uint32_t key_count = 0;   // 0: zero everywhere; 1: constant
+};
+
+struct ClipSource {
+  uint16_t version_major = 0, version_minor = 0;
+  uint32_t frame_count = 0;  // <= 2^24 (kMaxFrames): every frame position is exact in binary32
+  double frame_time = 0.0;
+  TangentRule rule = TangentRule::step_adjusted;
+  Skeleton skeleton;         // channel columns assigned
+  std::vector<SourceChannel> channels;
+  std::vector<uint32_t> frames;  // every channel's key frames, channel after channel, increasing
+  std::vector<int64_t> q;        // the matching quantized values, |q| <= 2^53, finite once dequantized
+  std::string notes;
+};
+
+// Frame positions stay exact in binary32 below 2^24; no clip may be longer (spec section 8).
+inline constexpr uint32_t kMaxFrames = 1u << 24;
+
+}  // namespace keyanim::internal

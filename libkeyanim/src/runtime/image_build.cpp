@@ -1,0 +1,213 @@
+// Building the runtime image (image.h) from a clip's decoded keys. Two passes over every curve:
+// the first sizes each record (its widths depend on the values in its window), the second
+// writes it at its place in the block-major payload.
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <limits>
+#include <utility>
+
+#include "runtime/image.h"
+
+namespace keyanim::internal {
+namespace {
+
+uint32_t bit_width(uint64_t x) noexcept { return static_cast<uint32_t>(std::bit_width(x)); }
+uint64_t zigzag(int64_t d) noexcept { return (static_cast<uint64_t>(d) << 1) ^ static_cast<uint64_t>(d >> 63); }
+
+// A curve's keys (n >= 2), extended on both sides by virtual keys that repeat the end values at
+// the end segments' spacing: index i < 0 or i >= n is such a key.
+struct Keys {
+  const uint32_t* k;
+  const int64_t* q;
+  int64_t n;
+  int64_t frame(int64_t i) const noexcept {
+    if (i < 0) return int64_t(k[0]) + (int64_t(k[1]) - int64_t(k[0])) * i;
+    if (i >= n) return int64_t(k[n - 1]) + (int64_t(k[n - 1]) - int64_t(k[n - 2])) * (i - n + 1);
+    return k[i];
+  }
+  int64_t value(int64_t i) const noexcept { return q[std::clamp<int64_t>(i, 0, n - 1)]; }
+};
+
+// One record's window: keys first - 2 .. last + 1, where [first, last) are the block's keys.
+struct RecordPlan {
+  int64_t first = 0, last = 0;
+  uint64_t base = 0;      // smallest value in the window, minus q_base
+  uint32_t value_bits = 0, context_bits = 0;
+  uint64_t size_bytes = 0;
+};
+
+RecordPlan plan_record(const Keys& keys, int64_t first, int64_t last, int64_t start, int64_t q_base,
+                       uint32_t base_bits) {
+  RecordPlan r;
+  r.first = first;
+  r.last = last;
+  int64_t lo = std::numeric_limits<int64_t>::max(), hi = std::numeric_limits<int64_t>::min();
+  for (int64_t i = first - 2; i <= last + 1; ++i) {
+    lo = std::min(lo, keys.value(i));
+    hi = std::max(hi, keys.value(i));
+  }
+  r.base = static_cast<uint64_t>(lo - q_base);
+  r.value_bits = bit_width(static_cast<uint64_t>(hi - lo));
+  const int64_t end = start + kBlockFrames;
+  const uint64_t context = zigzag(keys.frame(first - 2) - start) | zigzag(keys.frame(first - 1) - start) |
+                           zigzag(keys.frame(last) - end) | zigzag(keys.frame(last + 1) - end);
+  r.context_bits = bit_width(context);
+  const uint64_t bits = kRecordFixedBits + base_bits + kContextKeys * uint64_t(r.context_bits) +
+                        uint64_t(last - first + kContextKeys) * r.value_bits;
+  r.size_bytes = (bits + 7) / 8;
+  return r;
+}
+
+// Writes bits least significant first from byte `at`; the bytes must be zero beforehand.
+class BitWriter {
+ public:
+  explicit BitWriter(uint8_t* p) : p_(p) {}
+  void put(uint64_t v, uint32_t width) {
+    for (uint32_t done = 0; done < width;) {
+      const uint32_t room = 8 - (bit_ & 7);
+      const uint32_t take = std::min(room, width - done);
+      const uint64_t part = (v >> done) & ((uint64_t(1) << take) - 1);
+      p_[bit_ >> 3] = static_cast<uint8_t>(p_[bit_ >> 3] | (part << (bit_ & 7)));
+      bit_ += take;
+      done += take;
+    }
+  }
+
+ private:
+  uint8_t* p_;
+  uint64_t bit_ = 0;
+};
+
+void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t start, int64_t q_base,
+                  uint32_t base_bits) {
+  BitWriter w(out);
+  uint64_t mask = 0;
+  for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (keys.frame(i) - start);
+  w.put(mask, 64);
+  w.put(r.value_bits, 6);
+  w.put(r.context_bits, 5);
+  w.put(r.base, base_bits);
+  const int64_t end = start + kBlockFrames;
+  w.put(zigzag(keys.frame(r.first - 2) - start), r.context_bits);
+  w.put(zigzag(keys.frame(r.first - 1) - start), r.context_bits);
+  w.put(zigzag(keys.frame(r.last) - end), r.context_bits);
+  w.put(zigzag(keys.frame(r.last + 1) - end), r.context_bits);
+  const uint64_t low = static_cast<uint64_t>(q_base) + r.base;
+  for (int64_t i = r.first - 2; i <= r.last + 1; ++i)
+    w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
+}
+
+}  // namespace
+
+size_t Image::memory_bytes() const noexcept {
+  size_t n = sizeof(Image) + notes.capacity();
+  n += skeleton.joints.capacity() * sizeof(Joint);
+  for (const Joint& j : skeleton.joints) {
+    n += j.name.capacity() > 15 ? j.name.capacity() : 0;  // beyond the small-string buffer
+    n += j.channels.capacity() * sizeof(ChannelType);
+  }
+  n += node_offset.capacity() * sizeof(float);
+  n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
+  n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
+  n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
+  n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
+  return n;
+}
+
+std::shared_ptr<const Image> build_image(ClipSource&& src) {
+  auto img = std::make_shared<Image>();
+  img->version_major = src.version_major;
+  img->version_minor = src.version_minor;
+  img->frame_count = src.frame_count;
+  img->frame_time = src.frame_time;
+  img->rule = src.rule;
+  img->skeleton = std::move(src.skeleton);
+  for (const Joint& j : img->skeleton.joints)
+    for (double o : j.offset) img->node_offset.push_back(static_cast<float>(o));
+  img->notes = std::move(src.notes);
+  img->total_keys = src.frames.size();
+  static std::atomic<uint64_t> next_id{1};
+  img->id = next_id.fetch_add(1, std::memory_order_relaxed);
+
+  const size_t channels = src.channels.size();
+  img->interp.resize(channels);
+  img->tension.resize(channels);
+  img->key_count.resize(channels);
+  img->curve_of.assign(channels, kNoCurve);
+  img->fixed_value.assign(channels, 0.0f);
+  img->fixed_frame.assign(channels, 0);
+  for (size_t c = 0; c < channels; ++c) {
+    const SourceChannel& sc = src.channels[c];
+    img->interp[c] = sc.interp;
+    img->tension[c] = sc.tension;
+    img->key_count[c] = sc.key_count;
+    if (sc.key_count < 2) {
+      if (sc.key_count == 1) {
+        img->fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
+        img->fixed_frame[c] = src.frames[sc.first_key];
+      }
+      img->fixed_channels.push_back(static_cast<uint32_t>(c));
+      continue;
+    }
+    const int64_t* q = src.q.data() + sc.first_key;
+    const uint32_t* k = src.frames.data() + sc.first_key;
+    const uint32_t n = sc.key_count;
+    Curve cv;
+    cv.step = sc.step;
+    const auto [lo, hi] = std::minmax_element(q, q + n);
+    cv.q_base = *lo;
+    cv.base_bits = static_cast<uint8_t>(bit_width(static_cast<uint64_t>(*hi - *lo)));
+    cv.context_at = static_cast<uint16_t>(kRecordFixedBits + cv.base_bits);
+    cv.s = tension_to_s(sc.tension);
+    cv.first_frame = static_cast<float>(k[0]);
+    cv.last_frame = static_cast<float>(k[n - 1]);
+    cv.first_value = dequantize(q[0], sc.step);
+    cv.last_value = dequantize(q[n - 1], sc.step);
+    cv.channel = static_cast<uint32_t>(c);
+    cv.linear = sc.interp == Interpolation::linear;
+    img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
+    img->curves.push_back(cv);
+  }
+
+  const size_t nc = img->curves.size();
+  img->block_count = nc == 0 ? 0 : (src.frame_count + kBlockFrames - 1) / kBlockFrames;
+  const size_t records = size_t(img->block_count) * nc;
+  std::vector<RecordPlan> plans(records);
+  for (size_t i = 0; i < nc; ++i) {
+    const Curve& cv = img->curves[i];
+    const SourceChannel& sc = src.channels[cv.channel];
+    const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
+    int64_t first = 0, last = 0;  // the block's keys: [first, last)
+    for (uint32_t b = 0; b < img->block_count; ++b) {
+      const int64_t start = int64_t(b) << kBlockShift;
+      while (first < keys.n && int64_t(keys.k[first]) < start) ++first;
+      last = std::max(last, first);
+      while (last < keys.n && int64_t(keys.k[last]) < start + kBlockFrames) ++last;
+      plans[size_t(b) * nc + i] = plan_record(keys, first, last, start, cv.q_base, cv.base_bits);
+    }
+  }
+  // Offsets in block-major order; u32 offsets bound the payload (checked: 2^32 bytes is far
+  // beyond any clip the decoder's limits admit, but a too large one must fail, not wrap).
+  img->record_offset.resize(records);
+  uint64_t total = 0;
+  for (size_t r = 0; r < records; ++r) {
+    if (total > UINT32_MAX) throw std::bad_alloc();
+    img->record_offset[r] = static_cast<uint32_t>(total);
+    total += plans[r].size_bytes;
+  }
+  img->payload.assign(total + kPayloadPadding, 0);
+  for (size_t i = 0; i < nc; ++i) {
+    const Curve& cv = img->curves[i];
+    const SourceChannel& sc = src.channels[cv.channel];
+    const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
+    for (uint32_t b = 0; b < img->block_count; ++b) {
+      const size_t r = size_t(b) * nc + i;
+      write_record(img->payload.data() + img->record_offset[r], keys, plans[r], int64_t(b) << kBlockShift,
+                   cv.q_base, cv.base_bits);
+    }
+  }
+  return img;
+}
+
+}  // namespace keyanim::internal

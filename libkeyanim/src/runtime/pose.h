@@ -1,0 +1,19 @@
+// Engine-ready poses from channel values: Euler angles to quaternions (vectorized sine and
+// cosine), translations, and forward kinematics. Internal to the runtime.
+#pragma once
+#include <cstdint>
+
+#include "keyanim/pose.h"
+#include "runtime/image.h"
+
+namespace keyanim::internal {
+
+// Local transforms of nodes [first, last) from the values of their channels (columns
+// skeleton.joints[first].first_channel onward, in order): out[i - first] for node i.
+void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
+                      Transform* out) noexcept;
+
+// Turns local transforms of every node (out[i] for node i) into model-space ones, in place.
+void compose_model(const Image& img, Transform* out) noexcept;
+
+}  // namespace keyanim::internal
