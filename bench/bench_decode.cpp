@@ -1,23 +1,35 @@
-// Decode-side benchmark: load speed, random-access and sequential full-pose sampling against a
-// raw float32 pose copy, memory, and a measurement of container layout alternatives. Prints
-// JSON. Usage: bench_decode [file.bvh]   (default: the CMU 01_01 clip of the corpus)
+// Decode-side benchmark: what a loaded clip costs a game. Prints JSON.
 //
-// The clip is made without the encoder's key selection: keys every 8th frame (and the last),
-// values quantized with step 1e-3. If the encoder works, an error-bounded clip of the same
-// motion is measured too.
-#include <zstd.h>
-
+//   bench_decode [FILE.bvh] [--all]
+//
+// FILE (default: CMU 01_01 of the corpus) is encoded with the default settings, written and
+// loaded; then, medians over repeated rounds, against copying one raw float32 pose
+// (frames x channels array) in the same run:
+//   random_pose_ns      Clip::sample at random positions (Euler channels), warm caches
+//   random_local_ns     Clip::sample_local at random positions (quaternion + translation)
+//   sequential_pose_ns  playback through a Cursor at the clip's rate
+//   cold_pose_ns        one random pose with the clip's whole image flushed (clflush) first,
+//                       against cold_raw_copy_ns, a raw pose copy with its row flushed first
+//   load_mb_s           file bytes per second through Clip::load (validation included)
+// With --all, the same for every CMU 120 fps file of the corpus, with the bytes ACL needs at
+// the error keyanim reached (../shared/anchors, interpolated log-log).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <time.h>
+#if defined(__x86_64__)
+#include <emmintrin.h>
+#endif
 
 #include <nlohmann/json.hpp>
 
@@ -25,251 +37,241 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
+#include "runtime/clip_access.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
 using keyanim::Clip;
-using keyanim::offline::EncodedClip;
 using keyanim::offline::Motion;
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
+  return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// Thread CPU time: the benchmark machines are shared, and wall time would count waiting.
-double cpu_now_ns() {
+// Thread CPU time for batches (the machines are shared; wall time would count waiting).
+double cpu_ns() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return double(t.tv_sec) * 1e9 + double(t.tv_nsec);
 }
-
 template <class F>
-double time_ns(F&& f) {
-  const double t0 = cpu_now_ns();
+double batch_ns(F&& f) {
+  const double t0 = cpu_ns();
   f();
-  return cpu_now_ns() - t0;
+  return cpu_ns() - t0;
+}
+double wall_ns() {
+  return double(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::steady_clock::now().time_since_epoch()).count());
 }
 
-volatile float g_sink = 0;  // keeps results alive
+volatile float g_sink = 0;
 
-EncodedClip uniform_clip(const Motion& m, uint32_t interval, double step) {
-  EncodedClip e;
-  e.skeleton = m.skeleton;
-  e.frame_count = m.frame_count;
-  e.frame_time = m.frame_time;
-  e.tangent_rule = keyanim::TangentRule::step_adjusted;
-  const uint32_t C = m.channel_count();
-  for (uint32_t c = 0; c < C; ++c) {
-    keyanim::offline::EncodedChannel ch;
-    ch.step = step;
-    for (uint32_t f = 0; m.frame_count > 0; f += interval) {
-      const uint32_t k = std::min(f, m.frame_count - 1);  // always the last frame too
-      ch.frames.push_back(k);
-      ch.q.push_back(std::llround(m.value(k, c) / step));
-      if (k == m.frame_count - 1) break;
-    }
-    e.channels.push_back(std::move(ch));
-  }
-  return e;
+void flush(const void* p, size_t n) {
+#if defined(__x86_64__)
+  const auto* c = static_cast<const char*>(p);
+  for (size_t i = 0; i < n; i += 64) _mm_clflush(c + i);
+  if (n) _mm_clflush(c + n - 1);
+#else
+  (void)p, (void)n;
+#endif
+}
+void fence() {
+#if defined(__x86_64__)
+  _mm_mfence();
+#endif
 }
 
-struct SectionSizes {
-  uint64_t ktim_raw = 0, kval_raw = 0, ktim_stored = 0, kval_stored = 0, file = 0;
-};
-
-SectionSizes section_sizes(const std::vector<uint8_t>& f) {
-  SectionSizes s;
-  s.file = f.size();
-  uint32_t count = 0;
-  std::memcpy(&count, &f[16], 4);
-  for (uint32_t i = 0; i < count; ++i) {
-    const uint8_t* e = &f[24 + 24 * i];
-    uint64_t stored = 0, raw = 0;
-    std::memcpy(&stored, e + 8, 8);
-    std::memcpy(&raw, e + 16, 8);
-    if (std::memcmp(e, "KTIM", 4) == 0) s.ktim_raw = raw, s.ktim_stored = stored;
-    if (std::memcmp(e, "KVAL", 4) == 0) s.kval_raw = raw, s.kval_stored = stored;
-  }
-  return s;
+// Every array of a clip's image, for the cold measurement.
+template <class V>
+void flush_vec(const V& v) {
+  flush(v.data(), v.size() * sizeof(v[0]));
+}
+void flush_image(const Clip& clip) {
+  const keyanim::internal::Image& img = keyanim::ClipAccess::image(clip);
+  flush(&img, sizeof img);
+  flush_vec(img.payload);
+  flush_vec(img.record_offset);
+  flush_vec(img.curves);
+  flush_vec(img.curve_of);
+  flush_vec(img.fixed_value);
+  flush_vec(img.fixed_channels);
+  flush_vec(img.node_offset);
+  flush_vec(img.skeleton.joints);
+  for (const auto& j : img.skeleton.joints) flush_vec(j.channels);
 }
 
-void put_varint(std::vector<uint8_t>& out, uint64_t v) {
-  while (v >= 0x80) {
-    out.push_back(uint8_t(v | 0x80));
-    v >>= 7;
-  }
-  out.push_back(uint8_t(v));
-}
-uint64_t zz(int64_t d) { return (uint64_t(d) << 1) ^ uint64_t(d >> 63); }
-size_t zsize(const std::vector<uint8_t>& raw, int level) {
-  std::vector<uint8_t> z(ZSTD_compressBound(raw.size()));
-  return ZSTD_compress(z.data(), z.size(), raw.data(), raw.size(), level);
-}
-
-// Compressed bytes of the key data under several layouts (what section 4.4/4.5 chose vs
-// alternatives), so that the choice is measured, not assumed.
-nlohmann::json layout_experiment(const EncodedClip& e) {
-  std::vector<uint8_t> ktim, kval, kval2, inter;
-  for (const auto& ch : e.channels) {
-    std::vector<uint8_t> t, v;
-    for (size_t i = 0; i < ch.frames.size(); ++i) {
-      put_varint(t, i == 0 ? ch.frames[0] : ch.frames[i] - ch.frames[i - 1] - 1);
-      put_varint(v, zz(ch.q[i] - (i ? ch.q[i - 1] : 0)));
-      // Second-order: predict by linear extrapolation of the two previous keys.
-      const int64_t pred = i >= 2 ? 2 * ch.q[i - 1] - ch.q[i - 2] : i == 1 ? ch.q[0] : 0;
-      put_varint(kval2, zz(ch.q[i] - pred));
-    }
-    ktim.insert(ktim.end(), t.begin(), t.end());
-    kval.insert(kval.end(), v.begin(), v.end());
-    inter.insert(inter.end(), t.begin(), t.end());
-    inter.insert(inter.end(), v.begin(), v.end());
-  }
-  // Alternatives for the values: varints split into first bytes and continuation bytes, and
-  // 32-bit zigzag deltas stored as four byte planes (a "shuffle" filter).
-  std::vector<uint8_t> first_bytes, rest_bytes, planes[4];
-  for (const auto& ch : e.channels) {
-    for (size_t i = 0; i < ch.q.size(); ++i) {
-      const uint64_t v = zz(ch.q[i] - (i ? ch.q[i - 1] : 0));
-      std::vector<uint8_t> one;
-      put_varint(one, v);
-      first_bytes.push_back(one[0]);
-      rest_bytes.insert(rest_bytes.end(), one.begin() + 1, one.end());
-      for (int k = 0; k < 4; ++k) planes[k].push_back(uint8_t(v >> (8 * k)));
-    }
-  }
-  std::vector<uint8_t> both = ktim;
-  both.insert(both.end(), kval.begin(), kval.end());
-  const int L = 19;
-  nlohmann::json j;
-  j["separate_ktim_kval_frames"] = zsize(ktim, L) + zsize(kval, L);
-  j["one_frame_ktim_then_kval"] = zsize(both, L);
-  j["one_frame_interleaved_per_channel"] = zsize(inter, L);
-  j["separate_with_second_order_kval"] = zsize(ktim, L) + zsize(kval2, L);
-  j["separate_kval_varints_split_first_byte"] = zsize(ktim, L) + zsize(first_bytes, L) + zsize(rest_bytes, L);
-  j["separate_kval_u32_byte_planes"] =
-      zsize(ktim, L) + zsize(planes[0], L) + zsize(planes[1], L) + zsize(planes[2], L) + zsize(planes[3], L);
-  j["raw_ktim_kval"] = ktim.size() + kval.size();
-  return j;
-}
-
-nlohmann::json measure(const EncodedClip& e, const Motion& m) {
-  nlohmann::json j;
-  const auto bytes = keyanim::offline::write_kanim(e, 19);
-  if (bytes.empty()) return {{"error", "write_kanim refused the clip"}};
-  const SectionSizes sizes = section_sizes(bytes);
-  const uint32_t F = m.frame_count, C = m.channel_count();
-
-  // Load speed.
+nlohmann::json measure(const Motion& m, bool speed) {
+  keyanim::offline::EncodeSettings settings;
+  settings.threads = 0;
+  keyanim::offline::EncodeResult result;
+  std::string why;
+  if (!keyanim::offline::encode(m, settings, result, why)) return {{"error", why}};
+  const std::vector<uint8_t> bytes = keyanim::offline::write_kanim(result.clip);
   Clip clip;
-  std::vector<double> load_ns;
-  for (int r = 0; r < 15; ++r) {
-    load_ns.push_back(time_ns([&] {
-      if (Clip::load(bytes, clip) != keyanim::Status::ok) std::abort();
-    }));
-  }
-  const double load = median(load_ns);
-  const double key_array_bytes = double(clip.total_keys()) * 8.0;
-  const double key_stream_bytes = double(sizes.ktim_raw + sizes.kval_raw);
-
-  // Raw float32 frames x channels, and the positions every method visits.
-  std::vector<float> raw(size_t(F) * C);
-  for (size_t i = 0; i < raw.size(); ++i) raw[i] = float(m.values[i]);
-  const size_t poses = 50000;
-  std::vector<uint32_t> frames(poses);
-  std::vector<double> positions(poses);
-  uint64_t s = 12345;
-  for (size_t i = 0; i < poses; ++i) {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    const double x = double(s >> 11) / 9007199254740992.0 * double(F - 1);
-    positions[i] = x;
-    frames[i] = uint32_t(x);
-  }
-  std::vector<float> out(C);
-  std::vector<double> random_ns, seq_ns, copy_random_ns, copy_seq_ns;
-  keyanim::Cursor cursor;
-  cursor.prepare(clip);
-  for (int r = 0; r < 11; ++r) {
-    copy_random_ns.push_back(time_ns([&] {
-      for (size_t i = 0; i < poses; ++i) {
-        std::memcpy(out.data(), raw.data() + size_t(frames[i]) * C, C * sizeof(float));
-        g_sink = g_sink + out[i % C];
-      }
-    }) / double(poses));
-    random_ns.push_back(time_ns([&] {
-      for (size_t i = 0; i < poses; ++i) {
-        clip.sample(positions[i], out);
-        g_sink = g_sink + out[i % C];
-      }
-    }) / double(poses));
-    copy_seq_ns.push_back(time_ns([&] {
-      for (size_t i = 0; i < poses; ++i) {
-        std::memcpy(out.data(), raw.data() + size_t(i % F) * C, C * sizeof(float));
-        g_sink = g_sink + out[i % C];
-      }
-    }) / double(poses));
-    seq_ns.push_back(time_ns([&] {
-      for (size_t i = 0; i < poses; ++i) {
-        clip.sample(double(i % F), out, &cursor);  // playback, looping
-        g_sink = g_sink + out[i % C];
-      }
-    }) / double(poses));
-  }
-  const double rnd = median(random_ns), seq = median(seq_ns), crnd = median(copy_random_ns),
-               cseq = median(copy_seq_ns);
-
+  if (Clip::load(bytes, clip) != keyanim::Status::ok) return {{"error", "load failed"}};
+  nlohmann::json j;
+  const uint32_t F = m.frame_count, C = m.channel_count();
   j["frames"] = F;
   j["channels"] = C;
   j["keys"] = clip.total_keys();
-  j["file_bytes"] = sizes.file;
-  j["raw_float32_bytes"] = uint64_t(F) * C * 4;
-  j["ktim_bytes"] = {{"raw", sizes.ktim_raw}, {"stored", sizes.ktim_stored}};
-  j["kval_bytes"] = {{"raw", sizes.kval_raw}, {"stored", sizes.kval_stored}};
-  j["load_ms"] = load / 1e6;
-  j["load_mb_per_s_key_arrays"] = key_array_bytes / load * 1e3;
-  j["load_mb_per_s_key_streams"] = key_stream_bytes / load * 1e3;
-  j["load_mb_per_s_file"] = double(bytes.size()) / load * 1e3;
+  j["max_error"] = result.error.max_error;
+  j["file_bytes"] = bytes.size();
   j["memory_bytes"] = clip.memory_bytes();
-  j["key_array_bytes"] = uint64_t(key_array_bytes);
-  j["memory_over_key_arrays"] = double(clip.memory_bytes()) / key_array_bytes;
-  j["random_pose_ns"] = rnd;
-  j["sequential_cursor_pose_ns"] = seq;
-  j["raw_copy_random_pose_ns"] = crnd;
-  j["raw_copy_sequential_pose_ns"] = cseq;
-  j["ratio_random_vs_raw_copy"] = rnd / crnd;
-  j["ratio_sequential_vs_raw_sequential_copy"] = seq / cseq;
-  j["ratio_sequential_vs_raw_random_copy"] = seq / crnd;
-  j["targets"] = {{"random_max_ratio", 15}, {"sequential_max_ratio", 4}, {"load_min_mb_per_s", 200}};
-  j["key_layout_compressed_bytes"] = layout_experiment(e);
-  j["key_layout_compressed_bytes"]["this_format_varint_planes"] = sizes.ktim_stored + sizes.kval_stored;
+  j["memory_over_file"] = double(clip.memory_bytes()) / double(bytes.size());
+  j["raw_float32_bytes"] = uint64_t(F) * C * 4;
+  std::vector<double> load;
+  for (int r = 0; r < 21; ++r) load.push_back(batch_ns([&] { Clip::load(bytes, clip); }));
+  j["load_ms"] = median(load) / 1e6;
+  j["load_mb_s"] = double(bytes.size()) / median(load) * 1e3;
+  if (!speed || F < 2) return j;
+
+  std::vector<float> raw(size_t(F) * C);
+  for (size_t i = 0; i < raw.size(); ++i) raw[i] = float(m.values[i]);
+  const size_t poses = 20000;
+  std::vector<double> pos(poses);
+  std::vector<uint32_t> row(poses);
+  uint64_t s = 12345;
+  for (size_t i = 0; i < poses; ++i) {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    pos[i] = double(s >> 11) / 9007199254740992.0 * double(F - 1);
+    row[i] = uint32_t(pos[i]);
+  }
+  std::vector<float> out(C);
+  std::vector<keyanim::Transform> xf(clip.skeleton().joints.size());
+  keyanim::Cursor cursor;
+  cursor.prepare(clip);
+  std::vector<double> copy, rnd, local, seq;
+  for (int r = 0; r < 9; ++r) {  // interleaved rounds: drifts hit every figure alike
+    copy.push_back(batch_ns([&] {
+      for (size_t i = 0; i < poses; ++i) {
+        std::memcpy(out.data(), raw.data() + size_t(row[i]) * C, C * sizeof(float));
+        g_sink = g_sink + out[i % C];
+      }
+    }) / poses);
+    rnd.push_back(batch_ns([&] {
+      for (size_t i = 0; i < poses; ++i) {
+        clip.sample(pos[i], out);
+        g_sink = g_sink + out[i % C];
+      }
+    }) / poses);
+    local.push_back(batch_ns([&] {
+      for (size_t i = 0; i < poses; ++i) {
+        clip.sample_local(pos[i], xf);
+        g_sink = g_sink + xf[i % xf.size()].rotation[0];
+      }
+    }) / poses);
+    seq.push_back(batch_ns([&] {
+      for (size_t i = 0; i < poses; ++i) {
+        clip.sample(double(i % F), out, &cursor);  // playback at the clip's rate, looping
+        g_sink = g_sink + out[i % C];
+      }
+    }) / poses);
+  }
+  // Cold: everything the sample reads is flushed from every cache level first.
+  std::vector<double> cold, cold_copy;
+  for (size_t i = 0; i < 2000; ++i) {
+    flush(raw.data() + size_t(row[i]) * C, C * sizeof(float));
+    fence();
+    double t0 = wall_ns();
+    std::memcpy(out.data(), raw.data() + size_t(row[i]) * C, C * sizeof(float));
+    g_sink = g_sink + out[i % C];
+    cold_copy.push_back(wall_ns() - t0);
+    flush_image(clip);
+    fence();
+    t0 = wall_ns();
+    clip.sample(pos[i], out);
+    g_sink = g_sink + out[i % C];
+    cold.push_back(wall_ns() - t0);
+  }
+  const double c = median(copy);
+  j["raw_copy_ns"] = c;
+  j["random_pose_ns"] = median(rnd);
+  j["random_local_ns"] = median(local);
+  j["sequential_pose_ns"] = median(seq);
+  j["cold_raw_copy_ns"] = median(cold_copy);
+  j["cold_pose_ns"] = median(cold);
+  j["random_pose_x_copy"] = median(rnd) / c;
+  j["random_local_x_copy"] = median(local) / c;
+  j["sequential_pose_x_copy"] = median(seq) / c;
+  j["cold_pose_x_copy"] = median(cold) / median(cold_copy);
   return j;
+}
+
+// ACL's bytes at error e for a file (acl.tsv: joint and End Site positions), log-log between
+// the rows that bracket e, the nearest row outside them. 0 if the file has no rows.
+double acl_bytes_at(const std::string& file, double e) {
+  std::ifstream in(fs::path(KEYANIM_ANCHORS_DIR) / "acl.tsv");
+  std::string line;
+  std::vector<std::pair<double, double>> rows;  // error, bytes
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::istringstream f(line);
+    std::string name, frames, fps, thr, bytes, err;
+    if (std::getline(f, name, '\t') && name == file && std::getline(f, frames, '\t') && std::getline(f, fps, '\t') &&
+        std::getline(f, thr, '\t') && std::getline(f, bytes, '\t') && std::getline(f, err, '\t'))
+      rows.emplace_back(std::stod(err), std::stod(bytes));
+  }
+  if (rows.empty()) return 0.0;
+  std::sort(rows.begin(), rows.end());
+  if (e <= rows.front().first) return rows.front().second;
+  if (e >= rows.back().first) return rows.back().second;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (e > rows[i].first) continue;
+    const auto [e0, b0] = rows[i - 1];
+    const auto [e1, b1] = rows[i];
+    const double t = (std::log(e) - std::log(e0)) / (std::log(e1) - std::log(e0));
+    return std::exp(std::log(b0) + t * (std::log(b1) - std::log(b0)));
+  }
+  return rows.back().second;
+}
+
+bool read(const fs::path& p, Motion& m) {
+  keyanim::offline::BvhError err;
+  if (keyanim::offline::read_bvh_file(p.string(), m, err)) return true;
+  std::cerr << err.to_string() << "\n";
+  return false;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : std::string(KEYANIM_CORPUS_DIR) + "/cmu/assimp__01_01.bvh";
-  Motion m;
-  keyanim::offline::BvhError err;
-  if (!keyanim::offline::read_bvh_file(path, m, err)) {
-    std::cerr << err.to_string() << "\n";
-    return 1;
+  std::string path = std::string(KEYANIM_CORPUS_DIR) + "/cmu/assimp__01_01.bvh";
+  bool all = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--all") all = true;
+    else path = argv[i];
   }
-  nlohmann::json j;
+  Motion m;
+  if (!read(path, m)) return 1;
+  nlohmann::json j = measure(m, true);
   j["file"] = path;
-  j["joints"] = m.skeleton.joints.size();
-  j["uniform_every_8_step_1e-3"] = measure(uniform_clip(m, 8, 1e-3), m);
-
-  keyanim::offline::EncodeSettings settings;  // defaults: error-bounded keys
-  keyanim::offline::EncodeResult result;
-  std::string why;
-  const auto t0 = Clock::now();
-  if (keyanim::offline::encode(m, settings, result, why) && !result.clip.channels.empty()) {
-    j["encoder_default"] = measure(result.clip, m);
-    j["encoder_default"]["encode_s"] = std::chrono::duration<double>(Clock::now() - t0).count();
-  } else {
-    j["encoder_default"] = {{"error", why.empty() ? "encoder unavailable" : why}};
+  j["targets"] = {{"memory_over_file", 2}, {"random_pose_x_copy", 30}, {"random_local_x_copy", 40},
+                  {"sequential_pose_x_copy", 20}, {"cold_pose_x_copy", 5}, {"load_mb_s", 300},
+                  {"memory_over_acl", 1}};
+  if (all) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(fs::path(KEYANIM_CORPUS_DIR) / "cmu")) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    std::vector<double> over_acl;
+    for (const fs::path& p : files) {
+      Motion mm;
+      if (!read(p, mm) || mm.frame_time > 0.0105 || mm.frame_time < 0.0062) continue;  // 120 fps clips only
+      nlohmann::json r = measure(mm, true);
+      r["file"] = p.filename().string();
+      const double acl = acl_bytes_at(p.filename().string(), r.value("max_error", 0.0));
+      r["acl_bytes_at_equal_error"] = acl;
+      if (acl > 0) {
+        r["memory_over_acl"] = r["memory_bytes"].get<double>() / acl;
+        over_acl.push_back(r["memory_over_acl"].get<double>());
+      }
+      j["all"].push_back(r);
+    }
+    std::sort(over_acl.begin(), over_acl.end());
+    if (!over_acl.empty())
+      j["memory_over_acl"] = {{"median", median(over_acl)}, {"max", over_acl.back()}, {"min", over_acl.front()}};
   }
   std::cout << j.dump(1) << "\n";
   return 0;

@@ -109,7 +109,6 @@ class Clip {
                       PositionReading reading = PositionReading::replace) const noexcept;
 
  private:
-  friend class Cursor;
   friend struct ClipAccess;  // internal: the library builds clips from decoded keys
   std::shared_ptr<const internal::Image> image_;
 };
@@ -133,6 +132,7 @@ class Cursor {
 
  private:
   friend class Clip;
+  friend struct ClipAccess;
   std::unique_ptr<State> state_;
 };
 

@@ -10,6 +10,7 @@
 
 #include "internal/simd.h"
 #include "runtime/clip_access.h"
+#include "runtime/cursor_state.h"
 #include "runtime/pose.h"
 #include "runtime/sampler.h"
 
@@ -84,10 +85,10 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
     const uint8_t* rec = img.record(b, curve);
     uint64_t mask;
     std::memcpy(&mask, rec, 8);
-    const uint64_t widths = internal::read_bits(rec, 64, 11);
-    const uint32_t vw = static_cast<uint32_t>(widths & 63), kw = static_cast<uint32_t>(widths >> 6);
-    const uint64_t base = internal::read_bits(rec, internal::kRecordFixedBits, cv.base_bits);
-    uint64_t at = cv.context_at + 4ull * kw + 2ull * vw;  // the block's first key follows two context keys
+    const uint32_t vw = rec[8], kw = rec[9];
+    const uint64_t base_at = internal::kRecordBitsAt + 4ull * kw;
+    const uint64_t base = internal::read_bits(rec, base_at, cv.base_bits);
+    uint64_t at = base_at + cv.base_bits + 2ull * vw;  // the block's first key follows two context keys
     for (; mask != 0 && k < n; mask &= mask - 1, at += vw, ++k) {
       frames[k] = (b << internal::kBlockShift) + static_cast<uint32_t>(internal::low_bit(mask));
       values[k] = dequantize(cv.q_base + static_cast<int64_t>(base + internal::read_bits(rec, at, vw)), cv.step);
@@ -104,78 +105,6 @@ float Clip::sample_channel(uint32_t c, float frame_position) const noexcept {
   return v;
 }
 
-// ---- Cursor
-
-struct Cursor::State {
-  std::shared_ptr<const Image> image;
-  // Per curve, structure of arrays: the segment state of sampler.h's Segment.
-  std::vector<float> lo, hi, k0, k1, p0, d, m0, m1, value;
-  std::vector<uint32_t> linear, direct;  // all ones / zeros, for select
-  std::vector<float> result;             // per curve, before the scatter to channels
-  std::vector<float> channels;           // a whole pose, for sample_local/model
-};
-
-Cursor::Cursor() = default;
-Cursor::~Cursor() = default;
-Cursor::Cursor(Cursor&&) noexcept = default;
-Cursor& Cursor::operator=(Cursor&&) noexcept = default;
-
-Status Cursor::prepare(const Clip& clip) noexcept {
-  try {
-    auto st = std::make_unique<State>();
-    st->image = clip.image_;
-    const Image& img = ClipAccess::image(clip);
-    // Rounded up to whole SIMD lanes; an empty range (lo = +inf) makes every curve refresh.
-    const size_t n = (img.curves.size() + 3) & ~size_t(3);
-    const float inf = std::numeric_limits<float>::infinity();
-    for (auto* v : {&st->lo, &st->hi, &st->k0, &st->p0, &st->d, &st->m0, &st->m1, &st->value, &st->result})
-      v->assign(n, 0.0f);
-    st->lo.assign(n, inf);
-    st->k1.assign(n, 1.0f);
-    st->linear.assign(n, 0u);
-    st->direct.assign(n, ~0u);
-    st->channels.assign(img.interp.size(), 0.0f);
-    state_ = std::move(st);
-    return Status::ok;
-  } catch (const std::bad_alloc&) {
-    state_.reset();
-    return Status::limit_exceeded;
-  }
-}
-
-bool Cursor::prepared_for(const Clip& clip) const noexcept {
-  return state_ && state_->image && clip.image_ && state_->image->id == clip.image_->id;
-}
-
-namespace {
-
-// Playback through a prepared cursor: refresh the curves whose segment f left, then evaluate
-// every curve's polynomial 4 at a time (the same building blocks as the sampler).
-void sample_cursor(const Image& img, Cursor::State& st, float f, float* out) noexcept {
-  const uint32_t n = static_cast<uint32_t>(img.curves.size());
-  for (uint32_t i = 0; i < n; ++i) {
-    if (st.lo[i] <= f && f < st.hi[i]) continue;
-    internal::Segment s;
-    internal::locate_segment(img, i, f, s);
-    st.lo[i] = s.lo, st.hi[i] = s.hi, st.k0[i] = s.k0, st.k1[i] = s.k1;
-    st.p0[i] = s.o.p0, st.d[i] = s.o.d, st.m0[i] = s.o.m0, st.m1[i] = s.o.m1, st.value[i] = s.value;
-    st.linear[i] = s.linear ? ~0u : 0u;
-    st.direct[i] = s.direct ? ~0u : 0u;
-  }
-  using internal::F4;
-  const F4 fv(f);
-  for (uint32_t i = 0; i < n; i += 4) {
-    const F4 u = segment_u(fv, F4::load(&st.k0[i]), F4::load(&st.k1[i]));
-    const Operands<F4> o{F4::load(&st.p0[i]), F4::load(&st.d[i]), F4::load(&st.m0[i]), F4::load(&st.m1[i])};
-    const F4 v = select(&st.linear[i], linear_value(o.p0, o.d, u), hermite(o, u));
-    select(&st.direct[i], F4::load(&st.value[i]), v).store(&st.result[i]);
-  }
-  for (uint32_t i = 0; i < n; ++i) out[img.curves[i].channel] = st.result[i];
-  for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
-}
-
-}  // namespace
-
 // ---- Sampling
 
 Status Clip::sample(double frame_position, std::span<float> out, Cursor* cursor) const noexcept {
@@ -185,7 +114,7 @@ Status Clip::sample(double frame_position, std::span<float> out, Cursor* cursor)
   const float f = static_cast<float>(frame_position);
   if (cursor != nullptr) {
     if (!cursor->prepared_for(*this)) return Status::invalid_argument;
-    sample_cursor(img, *cursor->state_, f, out.data());
+    internal::sample_playback(img, *cursor->state_, f, out.data());
   } else {
     internal::sample_all(img, f, out.data());
   }
@@ -221,13 +150,19 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
   if (cursor != nullptr) {
     if (!cursor->prepared_for(*this)) return Status::invalid_argument;
     float* values = cursor->state_->channels.data();
-    sample_cursor(img, *cursor->state_, f, values);
+    internal::sample_playback(img, *cursor->state_, f, values);
     internal::local_transforms(img, 0, nodes, values, reading, out.data());
     return Status::ok;
   }
-  // Without a cursor, node by node in batches whose channels fit a stack buffer.
-  constexpr uint32_t kBatch = 256;
+  // Without a cursor, the whole pose in a stack buffer when it fits (the usual skeleton), else
+  // node by node in batches whose channels fit it.
+  constexpr uint32_t kBatch = 2048;
   float values[kBatch];
+  if (img.interp.size() <= kBatch) {
+    internal::sample_all(img, f, values);
+    internal::local_transforms(img, 0, nodes, values, reading, out.data());
+    return Status::ok;
+  }
   const auto& joints = img.skeleton.joints;
   for (uint32_t first = 0; first < nodes;) {
     uint32_t last = first;

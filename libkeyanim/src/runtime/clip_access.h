@@ -12,6 +12,7 @@ namespace keyanim {
 struct ClipAccess {
   static Clip make(std::shared_ptr<const internal::Image> image);
   static const internal::Image& image(const Clip& clip);
+  static const std::shared_ptr<const internal::Image>& shared(const Clip& clip) { return clip.image_; }
 };
 
 }  // namespace keyanim

@@ -11,15 +11,16 @@
 // Appendix A (P_{-1} = P_0, tangent scale 1). So a record is self-contained: sampling one
 // channel at one position reads one record header and one record.
 //
-// Record layout (byte-aligned start, then bit-packed least significant bit first):
-//   Mask          64 bits   bit t set: a key at frame block_start + t
-//   Value_Bits     6 bits   w, width of each value below (0..55)
-//   Context_Bits   5 bits   wk, width of each context frame below (0..31)
-//   Base          wc bits   the record's smallest q minus the curve's q_base (wc per curve)
-//   Context       4 x wk    zigzag(frame - block_start) of the two keys before the block,
-//                           zigzag(frame - block_end) of the two keys after it
-//   Values        n x w     q - q_base - Base of the window's n = popcount(Mask) + 4 keys, in
-//                           frame order: two before, the block's keys, two after
+// Record layout (byte-aligned start):
+//   bytes 0-7     Mask          bit t set: a key at frame block_start + t
+//   byte 8        Value_Bits    w, width of each value below (0..55)
+//   byte 9        Context_Bits  wk, width of each context frame below (0..31)
+//   then, bit-packed least significant bit first from byte 10:
+//   Context       4 x wk        zigzag(frame - block_start) of the two keys before the block,
+//                               zigzag(frame - block_end) of the two keys after it
+//   Base          wc            the record's smallest q minus the curve's q_base (wc per curve)
+//   Values        n x w         q - q_base - Base of the window's n = popcount(Mask) + 4 keys,
+//                               in frame order: two before, the block's keys, two after
 #pragma once
 #include <cstdint>
 #include <cstring>
@@ -35,22 +36,17 @@ namespace keyanim::internal {
 
 inline constexpr uint32_t kBlockShift = 6;
 inline constexpr uint32_t kBlockFrames = 1u << kBlockShift;
-inline constexpr uint32_t kRecordFixedBits = 64 + 6 + 5;  // Mask, Value_Bits, Context_Bits
+inline constexpr uint32_t kRecordBitsAt = 80;  // Context starts after Mask, Value_Bits, Context_Bits
 inline constexpr uint32_t kContextKeys = 4;
 inline constexpr uint32_t kNoCurve = UINT32_MAX;
 inline constexpr size_t kPayloadPadding = 8;  // so that an 8-byte load at any record bit is in bounds
 
-// Per curve: what the sampler needs besides the records. 48 bytes, one cache line for most.
+// Per curve, what reading its records needs (the rest is in Image's per-curve arrays).
 struct Curve {
+  int64_t q_base = 0;    // smallest q of the curve
   double step = 1.0;
-  int64_t q_base = 0;       // smallest q of the curve
-  float s = 0.5f;           // (1 - tension) / 2
-  float first_frame = 0.0f, last_frame = 0.0f;  // K_0 and K_{n-1}
-  float first_value = 0.0f, last_value = 0.0f;  // v_0 and v_{n-1}
-  uint32_t channel = 0;     // output column
-  uint16_t context_at = 0;  // bit offset of Context in a record: kRecordFixedBits + wc
-  uint8_t base_bits = 0;    // wc
-  uint8_t linear = 0;       // 1: linear interpolation
+  uint32_t channel = 0;  // output column
+  uint32_t base_bits = 0;  // wc
 };
 
 struct Image {
@@ -74,9 +70,14 @@ struct Image {
   std::vector<uint32_t> fixed_frame;  // the frame of a channel's single key (0 without keys)
   std::vector<uint32_t> fixed_channels;  // channels with fewer than two keys, in order
 
-  // Curves and their records.
+  // Curves and their records. The per-curve arrays are separate so that 4 curves load at once.
   std::vector<Curve> curves;
+  std::vector<float> curve_s;            // (1 - tension) / 2
+  std::vector<float> first_frame, last_frame;  // K_0 and K_{n-1}
+  std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
+  std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
   uint32_t block_count = 0;
+  uint32_t max_window = 0;              // most keys any record holds (block keys + 4)
   std::vector<uint32_t> record_offset;  // [block * curves.size() + curve]: byte offset in payload
   std::vector<uint8_t> payload;         // records, then kPayloadPadding zero bytes
 
@@ -101,14 +102,16 @@ inline int64_t unzigzag(uint64_t u) noexcept { return static_cast<int64_t>(u >> 
 // One record's window around position t (0 <= t < kBlockFrames: frame block_start + t, or the
 // block's first or last frame for positions outside it): key j is the last key at or before
 // block_start + t (a context key when the block has none up to t), and j-1, j+1, j+2 its
-// neighbours. Frames are relative to the block's start; values are q - q_base.
+// neighbours. Frames are relative to the block's start; value[k] + base + q_base is key k's q.
 struct Window {
-  int64_t frame[4];   // k_{j-1}, k_j, k_{j+1}, k_{j+2}
-  uint64_t value[4];  // q_{j-1} .. q_{j+2}, minus q_base
+  int32_t frame[4];   // k_{j-1}, k_j, k_{j+1}, k_{j+2}
+  uint64_t value[4];
+  uint64_t base;
+  uint32_t value_bits;
 };
 
 template <bool kPopcnt>
-inline uint32_t popcount64(uint64_t x) noexcept {
+[[gnu::always_inline]] inline uint32_t popcount64(uint64_t x) noexcept {
   if constexpr (kPopcnt) {
     return static_cast<uint32_t>(__builtin_popcountll(x));
   } else {  // SWAR: the baseline x86-64 has no popcnt instruction
@@ -120,46 +123,62 @@ inline uint32_t popcount64(uint64_t x) noexcept {
 }
 
 // Index of the highest set bit (x != 0) / lowest set bit (x != 0).
-inline int64_t top_bit(uint64_t x) noexcept { return 63 - __builtin_clzll(x); }
-inline int64_t low_bit(uint64_t x) noexcept { return __builtin_ctzll(x); }
+inline int32_t top_bit(uint64_t x) noexcept { return 63 - __builtin_clzll(x); }
+inline int32_t low_bit(uint64_t x) noexcept { return __builtin_ctzll(x); }
+inline int32_t unzigzag32(uint64_t u) noexcept {
+  return static_cast<int32_t>(static_cast<uint32_t>(u >> 1) ^ (0u - static_cast<uint32_t>(u & 1)));
+}
 
 template <bool kPopcnt>
-inline void read_window(const uint8_t* rec, const Curve& c, uint32_t t, Window& w) noexcept {
+[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint32_t t, Window& w) noexcept {
   uint64_t mask;
   std::memcpy(&mask, rec, 8);
-  const uint64_t widths = read_bits(rec, 64, 11);
-  const uint32_t vw = static_cast<uint32_t>(widths & 63);
-  const uint32_t kw = static_cast<uint32_t>(widths >> 6);
-  const uint64_t base = read_bits(rec, kRecordFixedBits, c.base_bits);
-  const uint64_t cat = c.context_at;
-  const int64_t before0 = unzigzag(read_bits(rec, cat, kw));
-  const int64_t before1 = unzigzag(read_bits(rec, cat + kw, kw));
-  const int64_t after0 = unzigzag(read_bits(rec, cat + 2 * kw, kw)) + kBlockFrames;
-  const int64_t after1 = unzigzag(read_bits(rec, cat + 3 * kw, kw)) + kBlockFrames;
-  // Keys up to t (bits 0..t) and after it.
+  const uint32_t vw = rec[8], kw = rec[9];
+  // The four context frames, from one load when they fit 64 bits (offsets below 2^15).
+  int32_t c[4];
+  if (kw <= 16) {
+    uint64_t x;
+    std::memcpy(&x, rec + 10, 8);
+    const uint64_t m = (uint64_t(1) << kw) - 1;
+    c[0] = unzigzag32(x & m);
+    c[1] = unzigzag32((x >> kw) & m);
+    c[2] = unzigzag32((x >> (2 * kw)) & m);
+    c[3] = unzigzag32((x >> (3 * kw)) & m);
+  } else {
+    for (uint32_t k = 0; k < 4; ++k) c[k] = unzigzag32(read_bits(rec, kRecordBitsAt + k * kw, kw));
+  }
+  c[2] += static_cast<int32_t>(kBlockFrames);
+  c[3] += static_cast<int32_t>(kBlockFrames);
+  // Keys up to t (bits 0..t) and after it; k_j, k_{j-1} are the highest keys at or below t,
+  // k_{j+1}, k_{j+2} the lowest above, else the context keys before or after the block.
   const uint64_t upto = t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1;
   const uint64_t below = mask & upto;
   const uint64_t above = mask & ~upto;
   const uint32_t count = popcount64<kPopcnt>(below);
-  // k_j and k_{j-1}: the highest keys at or below t, else the context before the block.
-  const int64_t top = top_bit(below | 1);  // | 1: defined when below is 0 (then unused)
+  const int32_t top = top_bit(below | 1);  // | 1: defined when below is 0 (then unused)
   const uint64_t below_rest = below & ~(uint64_t(1) << top);
-  const int64_t kj = below ? top : before1;
-  const int64_t kjm = below_rest ? top_bit(below_rest | 1) : (below ? before1 : before0);
-  // k_{j+1} and k_{j+2}: the lowest keys above t, else the context after the block.
   const uint64_t above_rest = above & (above - 1);
-  const int64_t kjp = above ? low_bit(above) : after0;
-  const int64_t kjp2 = above_rest ? low_bit(above_rest) : (above ? after0 : after1);
-  w.frame[0] = kjm;
-  w.frame[1] = kj;
-  w.frame[2] = kjp;
-  w.frame[3] = kjp2;
-  // Window index of key j: two context keys, then `count` keys up to t.
-  const uint64_t at = cat + 4 * uint64_t(kw) + uint64_t(count) * vw;  // value of k_{j-1}
-  w.value[0] = base + read_bits(rec, at, vw);
-  w.value[1] = base + read_bits(rec, at + vw, vw);
-  w.value[2] = base + read_bits(rec, at + 2 * vw, vw);
-  w.value[3] = base + read_bits(rec, at + 3 * vw, vw);
+  w.frame[0] = below_rest ? top_bit(below_rest | 1) : (below ? c[1] : c[0]);
+  w.frame[1] = below ? top : c[1];
+  w.frame[2] = above ? low_bit(above | (uint64_t(1) << 63)) : c[2];
+  w.frame[3] = above_rest ? low_bit(above_rest | (uint64_t(1) << 63)) : (above ? c[2] : c[3]);
+  // Values: two context keys, then `count` keys up to t; key j-1 is value `count`.
+  const uint64_t base_at = kRecordBitsAt + 4 * uint64_t(kw);
+  w.base = read_bits(rec, base_at, base_bits);
+  w.value_bits = vw;
+  const uint64_t at = base_at + base_bits + uint64_t(count) * vw;
+  if (vw <= 28) {  // two loads, two values each
+    const uint64_t m = (uint64_t(1) << vw) - 1;
+    uint64_t x, y;
+    std::memcpy(&x, rec + (at >> 3), 8);
+    std::memcpy(&y, rec + ((at + 2 * vw) >> 3), 8);
+    x >>= at & 7;
+    y >>= (at + 2 * vw) & 7;
+    w.value[0] = x & m, w.value[1] = (x >> vw) & m;
+    w.value[2] = y & m, w.value[3] = (y >> vw) & m;
+  } else {
+    for (uint32_t k = 0; k < 4; ++k) w.value[k] = read_bits(rec, at + k * vw, vw);
+  }
 }
 
 }  // namespace keyanim::internal

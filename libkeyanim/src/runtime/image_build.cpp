@@ -53,7 +53,7 @@ RecordPlan plan_record(const Keys& keys, int64_t first, int64_t last, int64_t st
   const uint64_t context = zigzag(keys.frame(first - 2) - start) | zigzag(keys.frame(first - 1) - start) |
                            zigzag(keys.frame(last) - end) | zigzag(keys.frame(last + 1) - end);
   r.context_bits = bit_width(context);
-  const uint64_t bits = kRecordFixedBits + base_bits + kContextKeys * uint64_t(r.context_bits) +
+  const uint64_t bits = kRecordBitsAt + kContextKeys * uint64_t(r.context_bits) + base_bits +
                         uint64_t(last - first + kContextKeys) * r.value_bits;
   r.size_bytes = (bits + 7) / 8;
   return r;
@@ -85,14 +85,14 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
   uint64_t mask = 0;
   for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (keys.frame(i) - start);
   w.put(mask, 64);
-  w.put(r.value_bits, 6);
-  w.put(r.context_bits, 5);
-  w.put(r.base, base_bits);
+  w.put(r.value_bits, 8);
+  w.put(r.context_bits, 8);
   const int64_t end = start + kBlockFrames;
   w.put(zigzag(keys.frame(r.first - 2) - start), r.context_bits);
   w.put(zigzag(keys.frame(r.first - 1) - start), r.context_bits);
   w.put(zigzag(keys.frame(r.last) - end), r.context_bits);
   w.put(zigzag(keys.frame(r.last + 1) - end), r.context_bits);
+  w.put(r.base, base_bits);
   const uint64_t low = static_cast<uint64_t>(q_base) + r.base;
   for (int64_t i = r.first - 2; i <= r.last + 1; ++i)
     w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
@@ -111,6 +111,9 @@ size_t Image::memory_bytes() const noexcept {
   n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
   n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
   n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
+  n += curve_s.capacity() * sizeof(float) + first_frame.capacity() * sizeof(float) +
+       last_frame.capacity() * sizeof(float) + first_value.capacity() * sizeof(float) +
+       last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t);
   n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
   return n;
 }
@@ -157,20 +160,28 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
     cv.step = sc.step;
     const auto [lo, hi] = std::minmax_element(q, q + n);
     cv.q_base = *lo;
-    cv.base_bits = static_cast<uint8_t>(bit_width(static_cast<uint64_t>(*hi - *lo)));
-    cv.context_at = static_cast<uint16_t>(kRecordFixedBits + cv.base_bits);
-    cv.s = tension_to_s(sc.tension);
-    cv.first_frame = static_cast<float>(k[0]);
-    cv.last_frame = static_cast<float>(k[n - 1]);
-    cv.first_value = dequantize(q[0], sc.step);
-    cv.last_value = dequantize(q[n - 1], sc.step);
+    cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
     cv.channel = static_cast<uint32_t>(c);
-    cv.linear = sc.interp == Interpolation::linear;
+    img->curve_s.push_back(tension_to_s(sc.tension));
+    img->first_frame.push_back(static_cast<float>(k[0]));
+    img->last_frame.push_back(static_cast<float>(k[n - 1]));
+    img->first_value.push_back(dequantize(q[0], sc.step));
+    img->last_value.push_back(dequantize(q[n - 1], sc.step));
+    img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
     img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
     img->curves.push_back(cv);
   }
 
   const size_t nc = img->curves.size();
+  // The per-curve arrays are read 4 curves at a time: pad them to whole lanes (never "in" a
+  // segment: the padding lanes are clamped constants).
+  const size_t lanes = (nc + 3) & ~size_t(3);
+  img->curve_s.resize(lanes, 0.0f);
+  img->first_frame.resize(lanes, std::numeric_limits<float>::infinity());
+  img->last_frame.resize(lanes, std::numeric_limits<float>::infinity());
+  img->first_value.resize(lanes, 0.0f);
+  img->last_value.resize(lanes, 0.0f);
+  img->curve_linear.resize(lanes, 0u);
   img->block_count = nc == 0 ? 0 : (src.frame_count + kBlockFrames - 1) / kBlockFrames;
   const size_t records = size_t(img->block_count) * nc;
   std::vector<RecordPlan> plans(records);
@@ -193,6 +204,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   uint64_t total = 0;
   for (size_t r = 0; r < records; ++r) {
     if (total > UINT32_MAX) throw std::bad_alloc();
+    img->max_window = std::max(img->max_window, static_cast<uint32_t>(plans[r].last - plans[r].first + kContextKeys));
     img->record_offset[r] = static_cast<uint32_t>(total);
     total += plans[r].size_bytes;
   }

@@ -1,8 +1,8 @@
 // Sampling the runtime image. Two passes over chunks of channels: a scalar pass reads each
-// curve's record (image.h: read_window) and gathers the Appendix A operands, then a SIMD pass
-// evaluates cardinal.h's building blocks 4 channels at a time. Both passes compute exactly
-// Appendix A, so every value is bit-identical to eval_channel's (tests check every channel of
-// every test vector and corpus clip).
+// curve's record (image.h: read_window) into its four key frames and dequantized values, then
+// a SIMD pass evaluates Appendix A with cardinal.h's building blocks 4 channels at a time.
+// Both passes compute exactly Appendix A, so every value is bit-identical to eval_channel's
+// (tests check every channel of every test vector and corpus clip).
 #include "runtime/sampler.h"
 
 #include <algorithm>
@@ -17,33 +17,33 @@ namespace {
 
 constexpr uint32_t kChunk = 32;  // a multiple of 4 (SIMD lanes)
 
-// Pass one's output for a chunk, structure of arrays.
+// Pass one's output for a chunk: per lane its keys j-1 .. j+2 (frames relative to the block,
+// dequantized values), and the per-curve facts the evaluation needs (which the sampler of all
+// curves reads straight from the image instead).
 struct Batch {
-  float k0[kChunk], k1[kChunk], len[kChunk], len_in[kChunk], len_out[kChunk];
-  float pm[kChunk], p0[kChunk], p1[kChunk], p2[kChunk], s[kChunk];
-  float direct_value[kChunk];
-  uint32_t linear[kChunk];  // all ones: linear interpolation
-  uint32_t direct[kChunk];  // all ones: the value is direct_value (clamped, at a key, fixed)
+  alignas(16) int32_t frames[kChunk][4];
+  alignas(16) float values[kChunk][4];
+  float s[kChunk], first_frame[kChunk], last_frame[kChunk], first_value[kChunk], last_value[kChunk];
+  uint32_t linear[kChunk];
+};
 
-  void set_direct(uint32_t i, float v) noexcept {
-    k0[i] = 0.0f, k1[i] = len[i] = len_in[i] = len_out[i] = 1.0f;
-    pm[i] = p0[i] = p1[i] = p2[i] = s[i] = 0.0f;
-    direct_value[i] = v;
-    linear[i] = 0;
-    direct[i] = ~0u;
-  }
+// The per-curve facts of a chunk, wherever they are.
+struct Facts {
+  const float *s, *first_frame, *last_frame, *first_value, *last_value;
+  const uint32_t* linear;
 };
 
 // Where position f falls: its block, and f relative to the block's start (exact: see below).
 struct Position {
-  float f;       // the position
-  float rel;     // f - block start, exact (Sterbenz: the start is 0, or >= 64 and > f / 2)
+  float f;    // the position
+  float rel;  // f - block start, exact (Sterbenz: the start is 0, or >= 64 and > f / 2)
   uint32_t block, t;
 };
 
 Position position(const Image& img, float f) noexcept {
   Position p;
   p.f = f;
+  if (img.block_count == 0) return {f, f, 0, 0};
   // Outside the clip every curve is clamped, whatever block is read; NaN never reaches here.
   const float end = static_cast<float>((img.block_count << kBlockShift) - 1);
   const float clamped = std::min(std::max(f, 0.0f), end);
@@ -54,92 +54,138 @@ Position position(const Image& img, float f) noexcept {
   return p;
 }
 
-// Pass one for one curve: the case of Appendix A and the segment's operands.
+// q = q_base + base + value, dequantized as Appendix A says (binary64 product, one rounding).
+// double(q_base + base) + double(value) is exact (|q| <= 2^53), so two lanes at a time with
+// SSE2 give the very same values.
+[[gnu::always_inline]] inline void dequantize4(const Window& w, const Curve& cv, float* out) noexcept {
+  const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
+#if KEYANIM_SSE2
+  if (w.value_bits <= 31) {
+    const __m128i v = _mm_set_epi32(static_cast<int32_t>(w.value[3]), static_cast<int32_t>(w.value[2]),
+                                    static_cast<int32_t>(w.value[1]), static_cast<int32_t>(w.value[0]));
+    const __m128d lowd = _mm_set1_pd(static_cast<double>(low)), step = _mm_set1_pd(cv.step);
+    const __m128d a = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(v), lowd), step);
+    const __m128d b = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(v, v)), lowd), step);
+    _mm_storeu_ps(out, _mm_movelh_ps(_mm_cvtpd_ps(a), _mm_cvtpd_ps(b)));
+    return;
+  }
+#endif
+  for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(w.value[k]), cv.step);
+}
+
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void gather(const Image& img, uint32_t curve, const Position& at, Batch& b,
                                           uint32_t i) noexcept {
   const Curve& cv = img.curves[curve];
   Window w;
-  read_window<kPopcnt>(img.record(at.block, curve), cv, at.t, w);
-  // Values: q = q_base + stored, dequantized as Appendix A says (binary64 product, one rounding).
-  float v[4];
-  for (int k = 0; k < 4; ++k) v[k] = dequantize(cv.q_base + static_cast<int64_t>(w.value[k]), cv.step);
-  b.pm[i] = v[0];
-  b.p0[i] = v[1];
-  b.p1[i] = v[2];
-  b.p2[i] = v[3];
-  // Frames relative to the block: exact integers; lengths rounded once from the integers.
-  b.k0[i] = static_cast<float>(w.frame[1]);
-  b.k1[i] = static_cast<float>(w.frame[2]);
-  const float len = static_cast<float>(w.frame[2] - w.frame[1]);
-  b.len[i] = len;
-  // The uniform rule is the step-adjusted one with equal lengths (tangent_scale gives exactly 1).
-  const bool adjusted = img.rule == TangentRule::step_adjusted;
-  b.len_in[i] = adjusted ? static_cast<float>(w.frame[1] - w.frame[0]) : len;
-  b.len_out[i] = adjusted ? static_cast<float>(w.frame[3] - w.frame[2]) : len;
-  b.s[i] = cv.s;
-  b.linear[i] = cv.linear ? ~0u : 0u;
-  // Appendix A's cases: f <= K_0, f >= K_{n-1}, f == K_j.
-  const bool before = !(at.f > cv.first_frame);
-  const bool after = at.f >= cv.last_frame;
-  const bool at_key = at.rel == b.k0[i];
-  b.direct[i] = (before || after || at_key) ? ~0u : 0u;
-  b.direct_value[i] = before ? cv.first_value : after ? cv.last_value : v[1];
+  read_window<kPopcnt>(img.record(at.block, curve), cv.base_bits, at.t, w);
+  std::memcpy(b.frames[i], w.frame, sizeof w.frame);
+  dequantize4(w, cv, b.values[i]);
 }
 
-// Pass two: Appendix A's segment value for a whole chunk, 4 lanes at a time.
-void evaluate(const Batch& b, float rel, float* res) noexcept {
-  const F4 f(rel);
-  for (uint32_t i = 0; i < kChunk; i += 4) {
-    const F4 k0 = F4::load(b.k0 + i), k1 = F4::load(b.k1 + i);
-    const F4 u = segment_u(f, k0, k1);
-    const F4 len = F4::load(b.len + i);
-    const F4 a0 = tangent_scale(len, F4::load(b.len_in + i));
-    const F4 a1 = tangent_scale(len, F4::load(b.len_out + i));
-    const Operands<F4> o = cardinal_operands(F4::load(b.pm + i), F4::load(b.p0 + i), F4::load(b.p1 + i),
-                                             F4::load(b.p2 + i), F4::load(b.s + i), a0, a1);
-    const F4 value = select(b.linear + i, linear_value(o.p0, o.d, u), hermite(o, u));
-    select(b.direct + i, F4::load(b.direct_value + i), value).store(res + i);
+void set_fixed(Batch& b, uint32_t i, float v) noexcept {
+  std::memset(b.frames[i], 0, sizeof b.frames[i]);
+  b.frames[i][2] = b.frames[i][3] = 1;
+  std::memset(b.values[i], 0, sizeof b.values[i]);
+  b.s[i] = 0.0f;
+  b.first_frame[i] = std::numeric_limits<float>::infinity();  // every position is "before"
+  b.last_frame[i] = std::numeric_limits<float>::infinity();
+  b.first_value[i] = b.last_value[i] = v;
+  b.linear[i] = 0;
+}
+
+void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept {
+  b.s[i] = img.curve_s[curve];
+  b.first_frame[i] = img.first_frame[curve];
+  b.last_frame[i] = img.last_frame[curve];
+  b.first_value[i] = img.first_value[curve];
+  b.last_value[i] = img.last_value[curve];
+  b.linear[i] = img.curve_linear[curve];
+}
+
+// Pass two: Appendix A for lanes [0, count) rounded up to 4. The frames and values of 4 lanes
+// are transposed into k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2} vectors.
+template <bool kAdjusted>
+void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count, float* res) noexcept {
+  const F4 f(at.f), rel(at.rel);
+  for (uint32_t i = 0; i < count; i += 4) {
+    I4 km = I4::load(b.frames[i]), kj = I4::load(b.frames[i + 1]), kp = I4::load(b.frames[i + 2]),
+       kp2 = I4::load(b.frames[i + 3]);
+    transpose(km, kj, kp, kp2);
+    F4 pm = F4::load(b.values[i]), p0 = F4::load(b.values[i + 1]), p1 = F4::load(b.values[i + 2]),
+       p2 = F4::load(b.values[i + 3]);
+    transpose(pm, p0, p1, p2);
+    // Lengths rounded once from the integer differences, as Appendix A; the uniform rule is
+    // the step-adjusted one with equal lengths (tangent_scale then gives exactly 1).
+    const F4 k0 = to_float(kj), k1 = to_float(kp), len = to_float(kp - kj);
+    const F4 a0 = kAdjusted ? tangent_scale(len, to_float(kj - km)) : F4(1.0f);
+    const F4 a1 = kAdjusted ? tangent_scale(len, to_float(kp2 - kp)) : F4(1.0f);
+    const F4 u = segment_u(rel, k0, k1);
+    const Operands<F4> o = cardinal_operands(pm, p0, p1, p2, F4::load(x.s + i), a0, a1);
+    const F4 value = select(F4::load_mask(x.linear + i), linear_value(o.p0, o.d, u), hermite(o, u));
+    // Appendix A's cases: f <= K_0 gives v_0, f >= K_{n-1} gives v_{n-1}, f == K_j gives v_j.
+    const F4 before = cmp_not_gt(f, F4::load(x.first_frame + i));
+    const F4 after = cmp_ge(f, F4::load(x.last_frame + i));
+    const F4 direct = select(before, F4::load(x.first_value + i), select(after, F4::load(x.last_value + i), p0));
+    select(mask_or(mask_or(before, after), cmp_eq(rel, k0)), direct, value).store(res + i);
   }
 }
 
-// The listed channels (or all when `channels` is null) at f, out[i] for the i-th.
+void evaluate(const Image& img, const Batch& b, const Facts& x, const Position& at, uint32_t count,
+              float* res) noexcept {
+  if (img.rule == TangentRule::step_adjusted)
+    evaluate<true>(b, x, at, count, res);
+  else
+    evaluate<false>(b, x, at, count, res);
+}
+
+Facts batch_facts(const Batch& b) {
+  return {b.s, b.first_frame, b.last_frame, b.first_value, b.last_value, b.linear};
+}
+
+// The listed channels at f, out[i] for channels[i].
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void sample_chunks(const Image& img, float f, const uint32_t* channels, uint32_t count,
                                                  float* out) noexcept {
   Batch b;
-  float res[kChunk];
-  const Position at = img.block_count ? position(img, f) : Position{f, f, 0, 0};
+  alignas(16) float res[kChunk];
+  const Position at = position(img, f);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
     for (uint32_t i = 0; i < m; ++i) {
       const uint32_t c = channels[base + i];
       const uint32_t curve = img.curve_of[c];
-      if (curve == kNoCurve)
-        b.set_direct(i, img.fixed_value[c]);
-      else
+      if (curve == kNoCurve) {
+        set_fixed(b, i, img.fixed_value[c]);
+      } else {
         gather<kPopcnt>(img, curve, at, b, i);
+        copy_facts(img, curve, b, i);
+      }
     }
-    for (uint32_t i = m; i < kChunk; ++i) b.set_direct(i, 0.0f);
-    evaluate(b, at.rel, res);
+    const uint32_t lanes = (m + 3) & ~3u;
+    for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
+    evaluate(img, b, batch_facts(b), at, lanes, res);
     std::memcpy(out + base, res, m * sizeof(float));
   }
 }
 
-// Every curve in order, written to its channel; the fixed channels separately.
+// Every curve in order, written to its channel; the fixed channels separately. The per-curve
+// facts are read from the image directly (the arrays are padded to whole SIMD lanes).
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   const uint32_t count = static_cast<uint32_t>(img.curves.size());
-  if (count == 0) return;
   Batch b;
-  float res[kChunk];
+  alignas(16) float res[kChunk];
   const Position at = position(img, f);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
     for (uint32_t i = 0; i < m; ++i) gather<kPopcnt>(img, base + i, at, b, i);
-    for (uint32_t i = m; i < kChunk; ++i) b.set_direct(i, 0.0f);
-    evaluate(b, at.rel, res);
+    const uint32_t lanes = (m + 3) & ~3u;
+    for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
+    const Facts x{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
+                  img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
+    evaluate(img, b, x, at, lanes, res);
     for (uint32_t i = 0; i < m; ++i) out[img.curves[base + i].channel] = res[i];
   }
 }
@@ -188,39 +234,72 @@ void sample_range(const Image& img, float f, uint32_t first, uint32_t count, flo
   }
 }
 
-void locate_segment(const Image& img, uint32_t curve, float f, Segment& s) noexcept {
+bool clamped_segment(const Image& img, uint32_t curve, float f, Segment& s) noexcept {
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  const Curve& cv = img.curves[curve];
-  s = Segment{};
-  if (!(f > cv.first_frame)) {  // clamped before the first key (f == K_0 included)
-    s.lo = -kInf, s.hi = std::nextafter(cv.first_frame, kInf), s.value = cv.first_value;
-    return;
+  const float first = img.first_frame[curve], last = img.last_frame[curve];
+  if (!(f > first)) {  // f == K_0 included
+    s = Segment{};
+    s.lo = -kInf, s.hi = std::nextafter(first, kInf), s.value = img.first_value[curve];
+    return true;
   }
-  if (f >= cv.last_frame) {
-    s.lo = cv.last_frame, s.hi = kInf, s.value = cv.last_value;
-    return;
+  if (f >= last) {
+    s = Segment{};
+    s.lo = last, s.hi = kInf, s.value = img.last_value[curve];
+    return true;
   }
-  Batch b;
-  const Position at = position(img, f);
-  gather<false>(img, curve, at, b, 0);  // one curve: popcount speed does not matter here
-  const float start = static_cast<float>(at.block << kBlockShift);
-  // Absolute key frames (exact: below 2^24), so that the segment serves positions in any block.
-  const float k0 = b.k0[0] + start, k1 = b.k1[0] + start;
+  return false;
+}
+
+void stream_segment(const Image& img, uint32_t curve, const KeyStream& ks, float f, Segment& s) noexcept {
+  // Key frames are exact in binary32 (below 2^24), so u from them equals the sampler's (both
+  // round f - K_j once); lengths are rounded once from the integer differences.
+  const int32_t* k = ks.k;
+  const float k0 = static_cast<float>(k[1]), k1 = static_cast<float>(k[2]);
   s.k0 = k0, s.k1 = k1, s.hi = k1;
-  s.linear = b.linear[0] != 0;
-  const float a0 = tangent_scale(b.len[0], b.len_in[0]);
-  const float a1 = tangent_scale(b.len[0], b.len_out[0]);
-  s.o = cardinal_operands(b.pm[0], b.p0[0], b.p1[0], b.p2[0], b.s[0], a0, a1);
+  s.linear = img.curve_linear[curve] != 0;
+  const float len = static_cast<float>(k[2] - k[1]);
+  const bool adjusted = img.rule == TangentRule::step_adjusted;
+  const float a0 = adjusted ? tangent_scale(len, static_cast<float>(k[1] - k[0])) : 1.0f;
+  const float a1 = adjusted ? tangent_scale(len, static_cast<float>(k[3] - k[2])) : 1.0f;
+  s.o = cardinal_operands(ks.v[0], ks.v[1], ks.v[2], ks.v[3], img.curve_s[curve], a0, a1);
+  s.value = s.o.p0;
   // At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's v_j, when the
   // operands are finite and p0 is not -0 (-0 + +0 is +0); else K_j is a direct state of its own.
   const bool exact_at_key = std::isfinite(s.o.d) && std::isfinite(s.o.m0) && std::isfinite(s.o.m1) &&
                             !(s.o.p0 == 0.0f && std::signbit(s.o.p0));
-  if (!exact_at_key && f == k0) {
-    s.lo = k0, s.hi = std::nextafter(k0, kInf), s.value = s.o.p0;
-    return;
-  }
-  s.lo = exact_at_key ? k0 : std::nextafter(k0, kInf);
-  s.direct = false;
+  s.direct = !exact_at_key && f == k0;
+  s.lo = exact_at_key || s.direct ? k0 : std::nextafter(k0, std::numeric_limits<float>::infinity());
+  if (s.direct) s.hi = std::nextafter(k0, std::numeric_limits<float>::infinity());
+}
+
+void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept {
+  const Position at = position(img, f);
+  const Curve& cv = img.curves[curve];
+  const uint8_t* rec = img.record(at.block, curve);
+  Window w;
+  read_window<false>(rec, cv.base_bits, at.t, w);
+  float v[4];
+  dequantize4(w, cv, v);
+  const int32_t start = static_cast<int32_t>(at.block << kBlockShift);
+  for (int i = 0; i < 4; ++i) s.k[i] = w.frame[i] + start, s.v[i] = v[i];
+  // Where key j+3 is: the block keys after key j+2, or the context keys after the block.
+  uint64_t mask;
+  std::memcpy(&mask, rec, 8);
+  const uint32_t kw = rec[9];
+  for (uint32_t k = 0; k < 2; ++k)
+    s.after[k] = unzigzag32(read_bits(rec, kRecordBitsAt + (2 + k) * kw, kw)) + start + int32_t(kBlockFrames);
+  const uint64_t upto = at.t >= 63 ? ~uint64_t(0) : (uint64_t(2) << at.t) - 1;
+  const uint64_t above = mask & ~upto;
+  const uint64_t above_rest = above & (above - 1);
+  s.rest = above_rest & (above_rest - 1);
+  s.after_used = above_rest ? 0 : above ? 1 : 2;
+  const uint32_t below = popcount64<false>(mask & upto);
+  s.value_bits = w.value_bits;
+  s.next_at = kRecordBitsAt + 4 * uint64_t(kw) + cv.base_bits + uint64_t(below + 4) * w.value_bits;
+  s.low = cv.q_base + static_cast<int64_t>(w.base);
+  s.block = static_cast<int32_t>(at.block);
+  s.rec = rec;
+  s.step = cv.step;
 }
 
 }  // namespace keyanim::internal

@@ -16,10 +16,47 @@ void sample_listed(const Image& img, float f, const uint32_t* channels, uint32_t
 // The channels first .. first + count - 1 (each < channel count): out[i] for channel first + i.
 void sample_range(const Image& img, float f, uint32_t first, uint32_t count, float* out) noexcept;
 
-// One curve's segment around f, prepared for playback: while lo <= f < hi the curve's value is
-// `value` if `direct`, else the segment polynomial at segment_u(f, k0, k1) (hermite, or
-// linear_value when `linear`). Computed with the same building blocks as sample_all, so the
-// values are identical.
+// Playback support (the Cursor): one curve's keys j-1 .. j+2 around the current position, and
+// where the next key of its record is, so that moving to the next segment reads one key.
+struct KeyStream {
+  int32_t k[4];          // absolute frames of keys j-1 .. j+2
+  float v[4];            // their values
+  const uint8_t* rec = nullptr;  // the record
+  double step = 1.0;
+  int64_t low = 0;       // q_base + the record's Base
+  uint64_t rest = 0;     // the record's block keys after key j+2 (mask bits)
+  uint64_t next_at = 0;  // bit position in the record of the next key's value
+  int32_t after[2];      // the record's two context keys after the block
+  int32_t block = -1;    // the record's block, -1 for none
+  uint32_t value_bits = 0;
+  uint32_t after_used = 0;  // context keys after the block already in k
+};
+
+// Positions the stream on the segment holding f (K_0 < f < K_{n-1}): reads f's record.
+void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept;
+// Moves the stream one key forward. False when its record has no further key (the position
+// has left the record's block: seek instead).
+inline bool advance_stream(KeyStream& s) noexcept {
+  int32_t next;
+  if (s.rest != 0) {
+    next = static_cast<int32_t>(static_cast<uint32_t>(s.block) << kBlockShift) + low_bit(s.rest);
+    s.rest &= s.rest - 1;
+  } else if (s.after_used < 2) {
+    next = s.after[s.after_used++];
+  } else {
+    return false;
+  }
+  const float value = dequantize(s.low + static_cast<int64_t>(read_bits(s.rec, s.next_at, s.value_bits)), s.step);
+  s.next_at += s.value_bits;
+  s.k[0] = s.k[1], s.k[1] = s.k[2], s.k[2] = s.k[3], s.k[3] = next;
+  s.v[0] = s.v[1], s.v[1] = s.v[2], s.v[2] = s.v[3], s.v[3] = value;
+  return true;
+}
+
+// The state of one curve for positions near f: while lo <= f < hi its value is `value` if
+// `direct`, else the segment polynomial at segment_u(f, k0, k1) (hermite, or linear_value
+// when `linear`). Computed with the same building blocks as sample_all, so the values are
+// identical.
 struct Segment {
   float lo = 0.0f, hi = 0.0f;
   float k0 = 0.0f, k1 = 1.0f;
@@ -28,6 +65,9 @@ struct Segment {
   bool direct = true;
   bool linear = false;
 };
-void locate_segment(const Image& img, uint32_t curve, float f, Segment& out) noexcept;
+// The clamped states (f <= K_0 or f >= K_{n-1}); false for positions between.
+bool clamped_segment(const Image& img, uint32_t curve, float f, Segment& out) noexcept;
+// The segment of a stream positioned at f.
+void stream_segment(const Image& img, uint32_t curve, const KeyStream& s, float f, Segment& out) noexcept;
 
 }  // namespace keyanim::internal
