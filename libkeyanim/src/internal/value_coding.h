@@ -30,6 +30,10 @@ inline int64_t extrapolated_delta(int64_t d, uint32_t g0, uint32_t g1) noexcept 
   if (d <= -kMaxExtrapolatedDelta || d >= kMaxExtrapolatedDelta || g0 >= kMaxExtrapolatedGap ||
       g1 >= kMaxExtrapolatedGap || g0 == 0)
     return d;
+  // Exact shortcuts of the formula below for the usual gaps (a division costs tens of cycles):
+  // equal gaps give floor(d + 1/2) = d, and g0 = 1 gives floor(d g1 + 1/2) = d g1.
+  if (g0 == g1) return d;
+  if (g0 == 1) return d * int64_t(g1);
   return floor_div(2 * d * int64_t(g1) + int64_t(g0), 2 * int64_t(g0));
 }
 

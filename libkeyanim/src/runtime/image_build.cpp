@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -42,11 +43,12 @@ RecordPlan plan_record(const Keys& keys, int64_t first, int64_t last, int64_t st
   RecordPlan r;
   r.first = first;
   r.last = last;
-  int64_t lo = std::numeric_limits<int64_t>::max(), hi = std::numeric_limits<int64_t>::min();
-  for (int64_t i = first - 2; i <= last + 1; ++i) {
-    lo = std::min(lo, keys.value(i));
-    hi = std::max(hi, keys.value(i));
-  }
+  // The window's values: the keys first - 2 .. last + 1 clamped to the curve (virtual keys
+  // repeat the end values).
+  const int64_t* q = keys.q + std::max<int64_t>(first - 2, 0);
+  const int64_t* q_end = keys.q + std::min(last + 1, keys.n - 1) + 1;
+  int64_t lo = *q, hi = *q;
+  for (; q < q_end; ++q) lo = std::min(lo, *q), hi = std::max(hi, *q);
   r.base = static_cast<uint64_t>(lo - q_base);
   r.value_bits = bit_width(static_cast<uint64_t>(hi - lo));
   const int64_t end = start + kBlockFrames;
@@ -59,19 +61,17 @@ RecordPlan plan_record(const Keys& keys, int64_t first, int64_t last, int64_t st
   return r;
 }
 
-// Writes bits least significant first from byte `at`; the bytes must be zero beforehand.
+// Writes bits least significant first into zeroed bytes, a 64-bit word at a time (the payload
+// has kPayloadPadding bytes after the last record, so a word never runs past it).
 class BitWriter {
  public:
   explicit BitWriter(uint8_t* p) : p_(p) {}
-  void put(uint64_t v, uint32_t width) {
-    for (uint32_t done = 0; done < width;) {
-      const uint32_t room = 8 - (bit_ & 7);
-      const uint32_t take = std::min(room, width - done);
-      const uint64_t part = (v >> done) & ((uint64_t(1) << take) - 1);
-      p_[bit_ >> 3] = static_cast<uint8_t>(p_[bit_ >> 3] | (part << (bit_ & 7)));
-      bit_ += take;
-      done += take;
-    }
+  void put(uint64_t v, uint32_t width) {  // width <= 57, v < 2^width
+    uint64_t x;
+    std::memcpy(&x, p_ + (bit_ >> 3), 8);
+    x |= v << (bit_ & 7);
+    std::memcpy(p_ + (bit_ >> 3), &x, 8);
+    bit_ += width;
   }
 
  private:
@@ -81,12 +81,12 @@ class BitWriter {
 
 void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t start, int64_t q_base,
                   uint32_t base_bits) {
-  BitWriter w(out);
   uint64_t mask = 0;
-  for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (keys.frame(i) - start);
-  w.put(mask, 64);
-  w.put(r.value_bits, 8);
-  w.put(r.context_bits, 8);
+  for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (keys.k[i] - start);
+  std::memcpy(out, &mask, 8);
+  out[8] = static_cast<uint8_t>(r.value_bits);
+  out[9] = static_cast<uint8_t>(r.context_bits);
+  BitWriter w(out + kRecordBitsAt / 8);
   const int64_t end = start + kBlockFrames;
   w.put(zigzag(keys.frame(r.first - 2) - start), r.context_bits);
   w.put(zigzag(keys.frame(r.first - 1) - start), r.context_bits);
@@ -94,7 +94,10 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
   w.put(zigzag(keys.frame(r.last + 1) - end), r.context_bits);
   w.put(r.base, base_bits);
   const uint64_t low = static_cast<uint64_t>(q_base) + r.base;
-  for (int64_t i = r.first - 2; i <= r.last + 1; ++i)
+  const int64_t inner_first = std::max<int64_t>(r.first - 2, 0), inner_last = std::min(r.last + 1, keys.n - 1);
+  for (int64_t i = r.first - 2; i < inner_first; ++i) w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
+  for (int64_t i = inner_first; i <= inner_last; ++i) w.put(static_cast<uint64_t>(keys.q[i]) - low, r.value_bits);
+  for (int64_t i = std::max(inner_last + 1, r.first - 2); i <= r.last + 1; ++i)
     w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
 }
 
