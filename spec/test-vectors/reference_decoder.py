@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reference decoder for .kanim 2.0 (and 1.0, Appendix E), written from spec/FORMAT.md alone.
+"""Reference decoder for .kanim 3.0 (and 2.0, 1.0: Appendix E), written from spec/FORMAT.md alone.
 
 It shares no code with the C++ library: it parses the bytes, checks the rules of the spec,
 and evaluates Appendix A in binary32 (every operation computed in binary64 and rounded once to
@@ -100,7 +100,7 @@ def parse(data):
     if len(data) < 24:
         raise KanimError("truncated", "header")
     major, minor, header_flags, count, reserved = struct.unpack_from("<HHIII", data, 8)
-    if major not in (1, 2):
+    if major not in (1, 2, 3):
         raise KanimError("unsupported_version", f"major {major}")
     if header_flags & 0xFFFF or reserved:
         raise KanimError("reserved_bits_set", "header")
@@ -192,10 +192,12 @@ def parse(data):
 
     # CHAN
     chan = content["CHAN"]
-    if len(chan) != (18 if major == 2 else 17) * C:
+    if len(chan) != {1: 17, 2: 18, 3: 19}[major] * C:
         raise KanimError("corrupt", "CHAN size")
-    # Value_Coding (2.0): 0 delta, 1 extrapolate; version 1 has only deltas.
-    coding = list(chan[17 * C:18 * C]) if major == 2 else [0] * C
+    # Value_Coding (2.0 on): 0 delta, 1 extrapolate; version 1 has only deltas.
+    coding = list(chan[17 * C:18 * C]) if major >= 2 else [0] * C
+    # Residual_Bytes (3.0): bytes of each zigzag residual in KVAL.
+    residual_bytes = list(chan[18 * C:19 * C]) if major == 3 else None
     interp = list(chan[:C])
     tension = list(struct.unpack_from(f"<{C}f", chan, C))
     step = list(struct.unpack_from(f"<{C}d", chan, 5 * C))
@@ -211,6 +213,8 @@ def parse(data):
             raise KanimError("corrupt", f"channel {c} key count")
         if coding[c] > 1:
             raise KanimError("reserved_bits_set", f"channel {c} value coding")
+        if residual_bytes is not None and (residual_bytes[c] > 8 or (key_count[c] == 0 and residual_bytes[c])):
+            raise KanimError("corrupt", f"channel {c} residual bytes")
     if sum(key_count) != K:
         raise KanimError("corrupt", "Key_Count sum")
 
@@ -228,35 +232,51 @@ def parse(data):
     if not r.at_end():
         raise KanimError("corrupt", "KTIM size")
 
-    # KVAL: Plane_Count, Plane_Size[], planes; byte k of each varint comes from plane k.
     kval = content["KVAL"]
-    if len(kval) < 1 or kval[0] > 10:
-        raise KanimError("corrupt", "Plane_Count")
-    P = kval[0]
-    if (P == 0) != (K == 0) or len(kval) < 1 + 4 * P:
-        raise KanimError("corrupt", "KVAL planes")
-    sizes = list(struct.unpack_from(f"<{P}I", kval, 1))
-    if 1 + 4 * P + sum(sizes) != len(kval) or 0 in sizes or (P and sizes[0] != K):
-        raise KanimError("corrupt", "KVAL plane sizes")
-    planes, at = [], 1 + 4 * P
-    for size in sizes:
-        planes.append(Reader(kval[at:at + size], "KVAL plane"))
-        at += size
+    if major == 3:
+        # KVAL (3.0): plane k holds byte k (little-endian) of every zigzag residual of the
+        # channels whose Residual_Bytes exceed k, channel after channel, key after key.
+        sizes = [sum(key_count[c] for c in range(C) if residual_bytes[c] > k) for k in range(8)]
+        if sum(sizes) != len(kval):
+            raise KanimError("corrupt", "KVAL size")
+        starts = [sum(sizes[:k]) for k in range(8)]
+        cursor = list(starts)
 
-    def plane_varint():
-        value = 0
-        for k in range(10):
-            if k >= P:
-                raise KanimError("corrupt", "varint past the last plane")
-            b = planes[k].take(1)[0]
-            value |= (b & 0x7F) << (7 * k)
-            if not b & 0x80:
-                if b == 0 and k > 0:
-                    raise KanimError("corrupt", "over-long varint")
-                if value >> 64:
-                    raise KanimError("corrupt", "varint too large")
-                return value
-        raise KanimError("corrupt", "varint too long")
+        def next_residual(c):
+            value = 0
+            for k in range(residual_bytes[c]):
+                value |= kval[cursor[k]] << (8 * k)
+                cursor[k] += 1
+            return value
+    else:
+        # KVAL (1.0, 2.0): Plane_Count, Plane_Size[], planes; byte k of each varint from plane k.
+        if len(kval) < 1 or kval[0] > 10:
+            raise KanimError("corrupt", "Plane_Count")
+        P = kval[0]
+        if (P == 0) != (K == 0) or len(kval) < 1 + 4 * P:
+            raise KanimError("corrupt", "KVAL planes")
+        sizes = list(struct.unpack_from(f"<{P}I", kval, 1))
+        if 1 + 4 * P + sum(sizes) != len(kval) or 0 in sizes or (P and sizes[0] != K):
+            raise KanimError("corrupt", "KVAL plane sizes")
+        planes, at = [], 1 + 4 * P
+        for size in sizes:
+            planes.append(Reader(kval[at:at + size], "KVAL plane"))
+            at += size
+
+        def next_residual(c):
+            value = 0
+            for k in range(10):
+                if k >= P:
+                    raise KanimError("corrupt", "varint past the last plane")
+                b = planes[k].take(1)[0]
+                value |= (b & 0x7F) << (7 * k)
+                if not b & 0x80:
+                    if b == 0 and k > 0:
+                        raise KanimError("corrupt", "over-long varint")
+                    if value >> 64:
+                        raise KanimError("corrupt", "varint too large")
+                    return value
+            raise KanimError("corrupt", "varint too long")
 
     def prediction(c, qs, i):
         """pred_i of section 4.5, in Python's exact integers (// is the floor)."""
@@ -274,9 +294,9 @@ def parse(data):
     for c in range(C):
         qs, vals = [], []
         for i in range(key_count[c]):
-            u = plane_varint()
+            u = next_residual(c)
             r = (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
-            if abs(r) > (2 ** 57 if major == 2 else 2 ** 54):
+            if abs(r) > (2 ** 57 if major >= 2 else 2 ** 54):
                 raise KanimError("corrupt", f"channel {c} residual")
             q = prediction(c, qs, i) + r
             qs.append(q)
@@ -287,7 +307,7 @@ def parse(data):
                 raise KanimError("corrupt", f"channel {c} value")
             vals.append(v)
         values.append(vals)
-    if not all(p.at_end() for p in planes):
+    if major < 3 and not all(p.at_end() for p in planes):
         raise KanimError("corrupt", "KVAL plane bytes left over")
 
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,

@@ -214,6 +214,48 @@ EncodedClip vector_predict() {
   return c;
 }
 
+// Version 3.0 adds nothing for blocks to the file, but a decoder's runtime layout (keyanim's:
+// 64-frame blocks, spec Appendix F) meets its limits here: keys on both sides of every block
+// boundary, a block full of keys, gaps spanning many blocks (context frames 2^15 and more
+// away), curves that start and end inside blocks, 2 keys in adjacent blocks, values across
+// the whole +-2^53 range, a uniform-rule twin is v3_uniform.
+EncodedClip vector_blocks() {
+  EncodedClip c;
+  c.skeleton.joints = {
+      node("Root", -1, 0, 0, 0, {CT::x_position, CT::y_position, CT::z_position, CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("Arm", 0, 4, 1, 0, {CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("Hand", 1, 0, 2, 0, {CT::z_rotation, CT::y_rotation}),
+      node("", 2, 0.5, 0, 0, {}, true),
+  };
+  c.frame_count = 70000;
+  c.frame_time = 1.0 / 120.0;
+  c.tangent_rule = TangentRule::step_adjusted;
+  std::vector<uint32_t> edges = {0, 1, 62, 63, 64, 65, 127, 128, 191, 192, 255, 256, 1000, 69998, 69999};
+  std::vector<int64_t> ev;
+  for (size_t i = 0; i < edges.size(); ++i) ev.push_back((int64_t(i) * 37) % 11 * 100 - 500);
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, edges, ev));
+  std::vector<uint32_t> full;
+  std::vector<int64_t> fv;
+  for (uint32_t f = 128; f < 256; ++f) full.push_back(f), fv.push_back(int64_t(f % 7) * 13 - int64_t(f / 9));
+  full.push_back(69999), fv.push_back(3);
+  c.channels.push_back(chan(kCard, 0.25f, 0.02, full, fv));
+  c.channels.push_back(chan(kCard, 0.0f, 0.1, {0, 5, 40000, 69999}, {10, -20, 30, -40}));  // far context
+  c.channels.push_back(chan(kCard, -0.5f, 0.05, {70, 75, 200}, {5, -5, 15}));  // starts and ends inside blocks
+  c.channels.push_back(chan(kLin, 0.0f, 0.1, {63, 64}, {-1000, 1000}));        // two keys, adjacent blocks
+  const int64_t big = int64_t(1) << 53;
+  c.channels.push_back(chan(kCard, 0.0f, 1e-20, {0, 64, 65, 129, 69999}, {big, -big, big - 1, -big + 1, 0}));
+  c.channels.push_back(chan(kCard, 0.0f, 0.5, {}, {}));      // zero
+  c.channels.push_back(chan(kCard, 0.0f, 0.5, {33}, {-7}));  // constant
+  std::vector<uint32_t> sparse;
+  std::vector<int64_t> sv;
+  for (uint32_t f = 0; f < 70000; f += 4999) sparse.push_back(f), sv.push_back(int64_t(f / 4999) * int64_t(f / 4999) * 50);
+  sparse.push_back(69999), sv.push_back(0);
+  c.channels.push_back(chan(kCard, 0.1f, 0.001, sparse, sv));
+  c.channels.push_back(chan(kLin, 0.0f, 0.25, {100, 160, 161, 224, 288, 289, 352}, {1, 2, 3, 4, 5, 6, 7}));
+  c.channels.push_back(chan(kCard, 0.0f, 0.125, {0, 69999}, {-3, 3}));
+  return c;
+}
+
 // A bigger pseudo-random clip: many densities, so that the segment index and cursor meet every
 // case (dense channels, sparse ones, keys far from the ends).
 uint64_t lcg(uint64_t& s) {
@@ -555,14 +597,16 @@ struct JsonParser {
 };
 
 // Version 1.0 files are frozen (written by the 1.0 writer); the current writer makes the rest.
-const char* const kVectorNames[] = {"v1_rules", "v1_uniform", "v1_single", "v1_long",
-                                    "v2_rules", "v2_long", "v2_predict"};
+const char* const kVectorNames[] = {"v1_rules",  "v1_uniform", "v1_single",  "v1_long",   "v2_rules",
+                                    "v2_long",   "v2_predict", "v3_rules",   "v3_uniform", "v3_single",
+                                    "v3_long",   "v3_predict", "v3_blocks"};
 EncodedClip vector_clip(const std::string& name) {
   const std::string kind = name.substr(3);
   if (kind == "rules") return vector_rules();
   if (kind == "uniform") return vector_uniform();
   if (kind == "single") return vector_single();
   if (kind == "predict") return vector_predict();
+  if (kind == "blocks") return vector_blocks();
   return vector_long();
 }
 std::string vector_path(const std::string& name, const char* ext) {
@@ -884,7 +928,17 @@ TEST_CASE("declared counts above the limits are refused before allocation") {
     poke(r.get("CLIP").stored, at, value);
     return r.build();
   };
-  CHECK_FAILS(with_clip(0, uint32_t(0xFFFFFFFFu)), Status::limit_exceeded, clip + 0);
+  // Above 2^24 frames a 3.x file breaks a rule; at 2^24 it only meets a decoder's limit.
+  CHECK_FAILS(with_clip(0, uint32_t(0xFFFFFFFFu)), Status::corrupt, clip + 0);
+  CHECK_FAILS(with_clip(0, uint32_t((1u << 24) + 1)), Status::corrupt, clip + 0);
+  {
+    keyanim::DecodeLimits lim;
+    lim.max_frames = 1000;
+    Clip out;
+    keyanim::ErrorInfo err;
+    CHECK(Clip::load(with_clip(0, uint32_t(1u << 24)), out, &err, lim) == Status::limit_exceeded);
+    CHECK(err.byte_offset == clip + 0);
+  }
   CHECK_FAILS(with_clip(4, uint32_t(0xFFFFFFFFu)), Status::limit_exceeded, clip + 4);
   CHECK_FAILS(with_clip(8, uint32_t(0xFFFFFFFFu)), Status::limit_exceeded, clip + 8);
   CHECK_FAILS(with_clip(24, uint64_t(1) << 40), Status::limit_exceeded, clip + 24);
@@ -1050,25 +1104,20 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
     r.get("KTIM").stored.push_back(0);
     CHECK_FAILS(r.build(), Status::corrupt, ktim + base.sections[3].stored.size());
   }
-  // KVAL, rebuilt here from the quantized values of vector_uniform by the spec's text: each
-  // channel's residuals under its Value_Coding (CHAN, 2.0) as zigzag LEB128 varints, byte k of
-  // each varint in plane k.
-  auto varint = [](uint64_t x) {
-    std::vector<uint8_t> v;
-    for (;; x >>= 7) {
-      v.push_back(uint8_t((x & 0x7F) | (x >= 0x80 ? 0x80 : 0)));
-      if (x < 0x80) return v;
-    }
-  };
+  CHECK_FAILS(with("CHAN", 18 * C + 2, uint8_t(9)), Status::corrupt, chan + 18 * C + 2);  // Residual_Bytes > 8
+  // KVAL, rebuilt here from the quantized values of vector_uniform by the spec's text (3.0):
+  // each channel's residuals under its Value_Coding, zigzag, Residual_Bytes little-endian
+  // bytes each, byte k of every residual of the channels with more than k bytes in plane k.
   auto zigzag = [](int64_t d) { return d >= 0 ? uint64_t(d) * 2 : uint64_t(-(d + 1)) * 2 + 1; };
   auto floor_div = [](int64_t a, int64_t b) { return a / b - ((a % b != 0 && a < 0) ? 1 : 0); };
-  std::vector<std::vector<uint8_t>> varints;
+  std::vector<std::vector<uint64_t>> residuals;  // zigzag, per channel
   const auto chans = vector_uniform().channels;
   for (size_t c = 0; c < chans.size(); ++c) {
     const auto& k = chans[c].frames;
     const auto& q = chans[c].q;
     const uint8_t coding = base.sections[2].stored[17 * C + c];
     REQUIRE(coding <= 1);
+    residuals.emplace_back();
     for (size_t i = 0; i < q.size(); ++i) {
       int64_t pred = i ? q[i - 1] : 0;
       if (coding == 1 && i >= 2) {
@@ -1078,75 +1127,142 @@ TEST_CASE("crafted CHAN KTIM KVAL") {
         else
           pred += d;
       }
-      varints.push_back(varint(zigzag(q[i] - pred)));
+      residuals.back().push_back(zigzag(q[i] - pred));
     }
   }
-  auto planes = [](const std::vector<std::vector<uint8_t>>& vs) {
-    std::vector<std::vector<uint8_t>> pl;
-    for (const auto& v : vs)
-      for (size_t k = 0; k < v.size(); ++k) {
-        if (pl.size() <= k) pl.emplace_back();
-        pl[k].push_back(v[k]);
-      }
-    std::vector<uint8_t> out = {uint8_t(pl.size())};
-    for (const auto& p : pl) put(out, uint32_t(p.size()));
-    for (const auto& p : pl) out.insert(out.end(), p.begin(), p.end());
+  std::vector<uint8_t> widths(base.sections[2].stored.begin() + 18 * C, base.sections[2].stored.end());
+  REQUIRE(widths.size() == C);
+  auto planes = [&](const std::vector<std::vector<uint64_t>>& rs, const std::vector<uint8_t>& ws) {
+    std::vector<uint8_t> out;
+    for (int k = 0; k < 8; ++k)
+      for (size_t c = 0; c < rs.size(); ++c)
+        if (ws[c] > k)
+          for (uint64_t z : rs[c]) out.push_back(uint8_t(z >> (8 * k)));
     return out;
   };
-  REQUIRE(planes(varints) == base.sections[4].stored);  // the writer follows the text
+  for (size_t c = 0; c < C; ++c) {  // the fewest bytes that hold every residual
+    uint64_t widest = 0;
+    for (uint64_t z : residuals[c]) widest |= z;
+    CHECK(widths[c] == (widest == 0 ? 0 : (std::bit_width(widest) + 7) / 8));
+  }
+  REQUIRE(planes(residuals, widths) == base.sections[4].stored);  // the writer follows the text
   const size_t kval = base.offset_of("KVAL");
-  const size_t first_byte = kval + 1 + 4 * 3;  // three planes: the largest zigzag is 36000
-  auto with_varints = [&](const std::vector<std::vector<uint8_t>>& vs) {
+  auto with_values = [&](const std::vector<std::vector<uint64_t>>& rs, std::vector<uint8_t> ws) {
     RawFile r = base;
-    r.get("KVAL").stored = planes(vs);
+    r.get("KVAL").stored = planes(rs, ws);
+    std::copy(ws.begin(), ws.end(), r.get("CHAN").stored.begin() + 18 * C);
     return r.build();
   };
   {
-    // First delta of channel 0 made 2^53 + 1: |q| > 2^53 (eight planes now).
-    auto vs = varints;
-    vs[0] = varint(zigzag((int64_t(1) << 53) + 1));
-    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 8);
-    vs[0] = varint(zigzag((int64_t(1) << 53)));
-    vs[1] = varint(zigzag(1));  // 2^53 + 1 in the second key
-    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 8 + 1);
+    // First residual of channel 0 made 2^53 + 1 (eight bytes): |q| > 2^53, at that key's byte
+    // in plane 0; then 2^53 and a second residual of 1.
+    auto rs = residuals;
+    auto ws = widths;
+    ws[0] = 8;
+    rs[0][0] = zigzag((int64_t(1) << 53) + 1);
+    CHECK_FAILS(with_values(rs, ws), Status::corrupt, kval);
+    rs[0][0] = zigzag(int64_t(1) << 53);
+    rs[0][1] = zigzag(1);
+    CHECK_FAILS(with_values(rs, ws), Status::corrupt, kval + 1);
+    // A residual beyond 2^57, even though q would be in range after it.
+    rs[0][0] = zigzag((int64_t(1) << 57) + 1);
+    rs[0][1] = zigzag(-(int64_t(1) << 57));
+    CHECK_FAILS(with_values(rs, ws), Status::corrupt, kval);
   }
   {
-    // A residual beyond 2^57 (nine planes), even though q would be in range after it.
-    auto vs = varints;
-    vs[0] = varint(zigzag((int64_t(1) << 57) + 1));
-    vs[1] = varint(zigzag(-(int64_t(1) << 57)));
-    CHECK_FAILS(with_varints(vs), Status::corrupt, kval + 1 + 4 * 9);
-  }
-  {
-    auto vs = varints;
-    vs[0] = {0x81, 0x00};  // 1, over-long
-    CHECK_FAILS(with_varints(vs), Status::corrupt, first_byte);
+    // Wider than needed is allowed: the same clip.
+    auto ws = widths;
+    for (auto& w : ws) w = w ? 8 : 0;
+    const Loaded l = load(with_values(residuals, ws));
+    REQUIRE(l.status == Status::ok);
+    check_same_clip(l.clip, keyanim::offline::to_clip(vector_uniform()));
   }
   {
     RawFile r = base;
     r.get("KVAL").stored.push_back(0);
+    CHECK_FAILS(r.build(), Status::corrupt, kval);  // more bytes than keys x Residual_Bytes
+    r.get("KVAL").stored.pop_back();
+    r.get("KVAL").stored.pop_back();
+    CHECK_FAILS(r.build(), Status::corrupt, kval);
+  }
+  {
+    // A channel without keys must have no residual bytes: channel 4's two keys removed (their
+    // gaps are the last two one-byte varints of KTIM), its Residual_Bytes left at 1.
+    auto ws = widths;
+    ws[4] = 1;
+    auto rs = residuals;
+    rs[4].clear();
+    RawFile z = base;
+    poke(z.get("CHAN").stored, 13 * C + 4 * 4, uint32_t(0));
+    poke(z.get("CLIP").stored, 24, uint64_t(18 - 2));
+    std::vector<uint8_t>& gaps = z.get("KTIM").stored;
+    REQUIRE(gaps.size() > 2);
+    gaps.erase(gaps.end() - 2, gaps.end());
+    z.get("KVAL").stored = planes(rs, ws);
+    std::copy(ws.begin(), ws.end(), z.get("CHAN").stored.begin() + 18 * C);
+    CHECK_FAILS(z.build(), Status::corrupt, chan + 18 * C + 4);
+  }
+  {
+    // A step so large that a value overflows binary32: at channel 0's first residual.
+    CHECK_FAILS(with("CHAN", 5 * C + 8 * 0, 1e300), Status::corrupt, kval);
+  }
+}
+
+// 2.x files (varint planes, spec Appendix E) still load, and their KVAL is still checked: the
+// committed v2_long vector, its sections decompressed.
+TEST_CASE("crafted KVAL of a 2.x file") {
+  RawFile base = split(read_file(vector_path("v2_long", ".kanim")));
+  REQUIRE(base.major == 2);
+  for (auto& sec : base.sections) {
+    if (!(sec.flags & 1)) continue;
+    std::vector<uint8_t> raw(size_t(ZSTD_getFrameContentSize(sec.stored.data(), sec.stored.size())));
+    REQUIRE(ZSTD_decompress(raw.data(), raw.size(), sec.stored.data(), sec.stored.size()) == raw.size());
+    sec.stored = raw;
+    sec.flags &= ~1u;
+  }
+  REQUIRE(load(base.build()).status == Status::ok);
+  const size_t kval = base.offset_of("KVAL");
+  const std::vector<uint8_t> v = base.get("KVAL").stored;
+  const uint8_t count = v[0];
+  REQUIRE(count >= 2);
+  {
+    RawFile r = base;
+    r.get("KVAL").stored.push_back(0);
     CHECK_FAILS(r.build(), Status::corrupt, kval + 1);  // plane sizes do not add up
-    r.get("KVAL").stored = base.sections[4].stored;
+    r.get("KVAL").stored = v;
     r.get("KVAL").stored[0] = 11;
     CHECK_FAILS(r.build(), Status::corrupt, kval);
-    r.get("KVAL").stored = {0};  // no planes for 18 keys
+    r.get("KVAL").stored = {0};  // no planes for the keys
     CHECK_FAILS(r.build(), Status::corrupt, kval);
   }
   {
     // Plane 0 one byte short, plane 1 one longer: sizes add up, plane 0 does not match K.
-    auto v = base.sections[4].stored;
+    auto w = v;
     uint32_t p0 = 0, p1 = 0;
-    std::memcpy(&p0, &v[1], 4);
-    std::memcpy(&p1, &v[5], 4);
-    poke(v, 1, p0 - 1);
-    poke(v, 5, p1 + 1);
+    std::memcpy(&p0, &w[1], 4);
+    std::memcpy(&p1, &w[5], 4);
+    poke(w, 1, p0 - 1);
+    poke(w, 5, p1 + 1);
     RawFile r = base;
-    r.get("KVAL").stored = v;
+    r.get("KVAL").stored = w;
     CHECK_FAILS(r.build(), Status::corrupt, kval + 1);
   }
   {
-    // A step so large that a value overflows binary32.
-    CHECK_FAILS(with("CHAN", 5 * C + 8 * 0, 1e300), Status::corrupt, first_byte);
+    // The first varint made over-long: its first byte gains a continuation and plane 1 a 0.
+    auto w = v;
+    const size_t first = 1 + 4 * size_t(count);
+    if (!(w[first] & 0x80)) {
+      uint32_t p1 = 0;
+      std::memcpy(&p1, &w[5], 4);
+      w[first] |= 0x80;
+      poke(w, 5, p1 + 1);
+      uint32_t p0 = 0;
+      std::memcpy(&p0, &w[1], 4);
+      w.insert(w.begin() + std::ptrdiff_t(first + p0), 0x00);
+      RawFile r = base;
+      r.get("KVAL").stored = w;
+      CHECK_FAILS(r.build(), Status::corrupt, kval + first);
+    }
   }
 }
 
@@ -1317,8 +1433,9 @@ TEST_CASE("test vectors load and equal their hand-built clips") {
     CAPTURE(name);
     const EncodedClip e = vector_clip(name);
     if (write && name.starts_with("v" + std::to_string(keyanim::kFormatVersionMajor) + "_")) {
-      // v2_predict is stored uncompressed, the others at level 19.
-      const auto bytes = keyanim::offline::write_kanim(e, name == "v2_predict" ? 0 : 19);
+      // *_predict and *_uniform are stored uncompressed, the others at level 19.
+      const bool raw = name.ends_with("_predict") || name.ends_with("_uniform");
+      const auto bytes = keyanim::offline::write_kanim(e, raw ? 0 : 19);
       std::ofstream(vector_path(name, ".kanim"), std::ios::binary)
           .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     }
@@ -1330,12 +1447,12 @@ TEST_CASE("test vectors load and equal their hand-built clips") {
   }
 }
 
-TEST_CASE("v2_predict holds both value codings and v2_long extrapolates") {
-  for (const char* name : {"v2_predict", "v2_long"}) {
+TEST_CASE("the predict vectors hold both value codings and the long ones extrapolate") {
+  for (const char* name : {"v2_predict", "v2_long", "v3_predict", "v3_long"}) {
     CAPTURE(name);
     const std::vector<uint8_t> bytes = read_file(vector_path(name, ".kanim"));
     REQUIRE(bytes.size() > 12);
-    CHECK(bytes[8] == 2);
+    CHECK(bytes[8] == name[1] - '0');
     CHECK(bytes[9] == 0);
     const Loaded l = load(bytes);
     REQUIRE(l.status == Status::ok);
@@ -1348,10 +1465,14 @@ TEST_CASE("v2_predict holds both value codings and v2_long extrapolates") {
       const auto& z = r.get("CHAN").stored;
       REQUIRE(ZSTD_decompress(chan.data(), chan.size(), z.data(), z.size()) == chan.size());
     }
-    REQUIRE(chan.size() == 18 * C);
-    const std::vector<uint8_t> codings(chan.begin() + 17 * C, chan.end());
+    REQUIRE(chan.size() == (bytes[8] == 3 ? 19 : 18) * C);
+    const std::vector<uint8_t> codings(chan.begin() + 17 * C, chan.begin() + 18 * C);
     CHECK(std::count(codings.begin(), codings.end(), 1) >= 1);
-    if (std::string(name) == "v2_predict") CHECK(std::count(codings.begin(), codings.end(), 0) >= 1);
+    if (std::string(name).ends_with("predict")) CHECK(std::count(codings.begin(), codings.end(), 0) >= 1);
+    if (bytes[8] == 3) {  // Residual_Bytes: v3_predict's deltas of 2^41 and more need 7 bytes
+      const std::vector<uint8_t> widths(chan.begin() + 18 * C, chan.end());
+      CHECK(*std::max_element(widths.begin(), widths.end()) == (std::string(name) == "v3_predict" ? 7 : 3));
+    }
   }
 }
 

@@ -9,7 +9,7 @@
 
 namespace keyanim {
 // What the writer writes.
-inline constexpr uint16_t kFormatVersionMajor = 2;
+inline constexpr uint16_t kFormatVersionMajor = 3;
 inline constexpr uint16_t kFormatVersionMinor = 0;
 // The loader reads every major version from this one to kFormatVersionMajor.
 inline constexpr uint16_t kOldestFormatVersionMajor = 1;

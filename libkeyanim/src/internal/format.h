@@ -35,8 +35,10 @@ inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTag
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count
-inline constexpr size_t kChanBytesPerChannel = 18;    // u8 + f32 + f64 + u32 + u8 (2.0)
-inline constexpr size_t kChanBytesPerChannelV1 = 17;  // 1.x: no Value_Coding
+inline constexpr size_t kChanBytesPerChannel = 19;    // u8 + f32 + f64 + u32 + u8 + u8 (3.0)
+inline constexpr size_t kChanBytesPerChannelV2 = 18;  // 2.x: no Residual_Bytes
+inline constexpr size_t kChanBytesPerChannelV1 = 17;  // 1.x: no Value_Coding either
+inline constexpr uint32_t kMaxResidualBytes = 8;      // zigzag residuals are below 2^58
 inline constexpr uint8_t kNodeEndSite = 1u << 0;
 inline constexpr uint8_t kNodeReservedMask = 0xFEu;
 inline constexpr uint32_t kMaxNodeChannels = 6;

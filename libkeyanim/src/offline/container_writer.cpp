@@ -45,17 +45,31 @@ size_t varint_bytes(const std::vector<int64_t>& r) {
   return n;
 }
 
-// Per channel, the coding whose residual varints are shorter (delta on a tie): extrapolation
-// pays on smooth channels with sparse keys and loses on noisy ones (spec Appendix D).
-std::vector<ValueCoding> choose_codings(const std::vector<EncodedChannel>& chans) {
-  std::vector<ValueCoding> out(chans.size(), ValueCoding::delta);
+// How KVAL stores each channel's values: the prediction, and the bytes per residual.
+struct ValuePlan {
+  std::vector<ValueCoding> coding;
+  std::vector<uint8_t> bytes;  // Residual_Bytes: the fewest that hold every zigzag residual
+};
+
+// Per channel, the coding whose residuals are smaller (their varint bytes, a proxy for what
+// zstd makes of them; delta on a tie): extrapolation pays on smooth channels with sparse keys
+// and loses on noisy ones (spec Appendix D).
+ValuePlan plan_values(const std::vector<EncodedChannel>& chans) {
+  ValuePlan plan;
+  plan.coding.assign(chans.size(), ValueCoding::delta);
+  plan.bytes.assign(chans.size(), 0);
   std::vector<int64_t> d, e;
   for (size_t c = 0; c < chans.size(); ++c) {
     residuals(chans[c], ValueCoding::delta, d);  // |q| <= 2^53: always in range
-    if (residuals(chans[c], ValueCoding::extrapolate, e) && varint_bytes(e) < varint_bytes(d))
-      out[c] = ValueCoding::extrapolate;
+    if (residuals(chans[c], ValueCoding::extrapolate, e) && varint_bytes(e) < varint_bytes(d)) {
+      plan.coding[c] = ValueCoding::extrapolate;
+      d.swap(e);
+    }
+    uint64_t widest = 0;
+    for (int64_t r : d) widest |= internal::zigzag_encode(r);
+    while (widest >> (8 * plan.bytes[c])) ++plan.bytes[c];
   }
-  return out;
+  return plan;
 }
 
 std::string channel_problem(const EncodedChannel& ch, uint32_t frame_count) {
@@ -102,14 +116,15 @@ std::vector<uint8_t> skel_section(const Skeleton& skel) {
 }
 
 // Column by column: values of one kind sit together and compress better.
-std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans, const std::vector<ValueCoding>& codings) {
+std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans, const ValuePlan& plan) {
   std::vector<uint8_t> s;
   s.reserve(chans.size() * internal::kChanBytesPerChannel);
   for (const auto& c : chans) put_le<uint8_t>(s, static_cast<uint8_t>(c.interp));
   for (const auto& c : chans) put_le<float>(s, c.tension);
   for (const auto& c : chans) put_le<double>(s, c.step);
   for (const auto& c : chans) put_le<uint32_t>(s, static_cast<uint32_t>(c.frames.size()));
-  for (ValueCoding v : codings) put_le<uint8_t>(s, static_cast<uint8_t>(v));
+  for (ValueCoding v : plan.coding) put_le<uint8_t>(s, static_cast<uint8_t>(v));
+  for (uint8_t b : plan.bytes) put_le<uint8_t>(s, b);
   return s;
 }
 
@@ -122,34 +137,22 @@ std::vector<uint8_t> ktim_section(const std::vector<EncodedChannel>& chans) {
   return s;
 }
 
-// The value varints split into byte planes: plane k holds the k-th byte of every varint that
-// has one. First bytes (mostly small deltas), and the rarer high bytes, then each form a
-// stream of like statistics, which zstd codes 5-9 % smaller than the varints in sequence.
-std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans, const std::vector<ValueCoding>& codings) {
-  std::vector<uint8_t> planes[internal::kMaxVarint64Bytes];
-  std::vector<uint8_t> one;
+// The zigzag residuals in byte planes: plane k holds byte k of every residual of the channels
+// whose residuals have more than k bytes. Low bytes (nearly uniform) and high bytes (mostly
+// small) then form streams of like statistics; `breaks` gets the plane boundaries, where the
+// writer ends a zstd block so that each plane gets its own entropy tables.
+std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans, const ValuePlan& plan,
+                                  std::vector<size_t>& breaks) {
+  std::vector<uint8_t> s;
   std::vector<int64_t> r;
-  for (size_t c = 0; c < chans.size(); ++c) {
-    residuals(chans[c], codings[c], r);  // in range: choose_codings checked
-    for (int64_t x : r) {
-      one.clear();
-      put_varint(one, internal::zigzag_encode(x));
-      for (size_t k = 0; k < one.size(); ++k) planes[k].push_back(one[k]);
+  for (uint32_t k = 0; k < internal::kMaxResidualBytes; ++k) {
+    const size_t plane_start = s.size();
+    for (size_t c = 0; c < chans.size(); ++c) {
+      if (plan.bytes[c] <= k) continue;
+      residuals(chans[c], plan.coding[c], r);  // in range: plan_values checked
+      for (int64_t x : r) s.push_back(static_cast<uint8_t>(internal::zigzag_encode(x) >> (8 * k)));
     }
-  }
-  uint8_t count = 0;
-  while (count < internal::kMaxVarint64Bytes && !planes[count].empty()) ++count;
-  std::vector<uint8_t> s(1, count);  // Plane_Count
-  size_t total = s.size();
-  for (uint8_t k = 0; k < count; ++k) {
-    put_le<uint32_t>(s, static_cast<uint32_t>(planes[k].size()));
-    total += 4 + planes[k].size();
-  }
-  s.resize(total);  // then copy: GCC 12 warns falsely (-Wstringop-overflow) on inserts here
-  size_t at = 1 + 4 * size_t(count);
-  for (uint8_t k = 0; k < count; ++k) {
-    if (!planes[k].empty()) std::memcpy(s.data() + at, planes[k].data(), planes[k].size());
-    at += planes[k].size();
+    if (s.size() > plane_start && plane_start > 0) breaks.push_back(plane_start);
   }
   return s;
 }
@@ -200,20 +203,6 @@ Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZST
   }
   sec.stored = std::move(raw);
   return sec;
-}
-
-// Plane boundaries of a KVAL section (after the header, and after every plane but the last).
-std::vector<size_t> kval_breaks(const std::vector<uint8_t>& kval) {
-  std::vector<size_t> breaks;
-  const size_t count = kval.empty() ? 0 : kval[0];
-  size_t at = 1 + 4 * count;
-  for (size_t k = 0; k + 1 < count; ++k) {
-    uint32_t n = 0;
-    std::memcpy(&n, kval.data() + 1 + 4 * k, 4);  // written just above by this file
-    at += internal::load_le<uint32_t>(reinterpret_cast<const uint8_t*>(&n));
-    breaks.push_back(at);
-  }
-  return breaks;
 }
 
 uint32_t crc32_of(const uint8_t* p, size_t n) {
@@ -277,14 +266,14 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
   std::vector<Section> sections;
   sections.push_back(make_section(internal::kTagClip, 0, clip_section(clip, keys), nullptr, level));
   sections.push_back(make_section(internal::kTagSkel, 0, skel_section(clip.skeleton), cctx, level));
-  const std::vector<ValueCoding> codings = choose_codings(clip.channels);
-  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels, codings), cctx, level));
+  const ValuePlan plan = plan_values(clip.channels);
+  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels, plan), cctx, level));
   sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
   {
     // A block per plane: each gets its own entropy tables. (Also compressing without the
     // breaks and keeping the smaller won 0.005% on the CMU clips for a fifth of the encode.)
-    std::vector<uint8_t> kval = kval_section(clip.channels, codings);
-    const std::vector<size_t> breaks = kval_breaks(kval);
+    std::vector<size_t> breaks;
+    std::vector<uint8_t> kval = kval_section(clip.channels, plan, breaks);
     sections.push_back(make_section(internal::kTagKval, 0, std::move(kval), cctx, level, breaks));
   }
   if (!clip.notes.empty()) {

@@ -94,7 +94,12 @@ class Loader {
   Status parse_skel(const Content& c, ClipSource& parts);
   Status parse_chan(const Content& c, ClipSource& parts);
   Status parse_ktim(const Content& c, ClipSource& parts);
-  Status parse_kval(const Content& c, ClipSource& parts);
+  Status parse_kval(const Content& c, ClipSource& parts);        // 1.x and 2.x: varint planes
+  Status parse_kval_fixed(const Content& c, ClipSource& parts);  // 3.x: fixed-width byte planes
+  // Turns channel ch's residual r (of key i, found at section offset at) into q, checking the
+  // bounds of section 4.5; q and q_prev carry the previous two.
+  Status residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i, uint64_t zigzag, int64_t& q,
+                       int64_t& q_prev, ClipSource& parts);
 
   std::span<const uint8_t> bytes_;
   const DecodeLimits& limits_;
@@ -116,6 +121,7 @@ class Loader {
   uint32_t channel_count_ = 0;
   // From CHAN, needed by KVAL.
   std::vector<internal::ValueCoding> codings_;  // all delta in 1.x
+  std::vector<uint8_t> residual_bytes_;         // 3.x
 };
 
 Status Loader::read_header_and_table() {
@@ -285,6 +291,8 @@ Status Loader::parse_clip(const Content& c, ClipSource& parts) {
   r.read(reserved);
   r.read(frame_time);
   r.read(key_count_);
+  if (major_ >= 3 && frames > internal::kMaxFrames)
+    return fail_in(Status::corrupt, c, 0, "Frame_Count " + std::to_string(frames) + " is above 2^24");
   if (frames > std::min(limits_.max_frames, internal::kMaxFrames))
     return fail_in(Status::limit_exceeded, c, 0, "Frame_Count " + std::to_string(frames) + " exceeds the limit");
   if (node_count_ > limits_.max_joints)
@@ -370,12 +378,15 @@ Status Loader::parse_skel(const Content& c, ClipSource& parts) {
 
 Status Loader::parse_chan(const Content& c, ClipSource& parts) {
   const uint64_t channels = channel_count_;
-  const size_t per_channel = major_ >= 2 ? internal::kChanBytesPerChannel : internal::kChanBytesPerChannelV1;
+  const size_t per_channel = major_ >= 3   ? internal::kChanBytesPerChannel
+                             : major_ == 2 ? internal::kChanBytesPerChannelV2
+                                           : internal::kChanBytesPerChannelV1;
   if (c.size != channels * per_channel)
     return fail_in(Status::corrupt, c, 0, "CHAN must be " + std::to_string(per_channel) + " x Channel_Count bytes");
   const uint8_t* p = c.data;
   parts.channels.resize(channels);
   codings_.assign(channels, internal::ValueCoding::delta);
+  residual_bytes_.assign(channels, 0);
   uint64_t key_sum = 0;
   for (uint64_t i = 0; i < channels; ++i) {
     const std::string ch = "channel " + std::to_string(i) + ": ";
@@ -398,6 +409,12 @@ Status Loader::parse_chan(const Content& c, ClipSource& parts) {
       if (p[at_coding] > internal::kMaxValueCoding)
         return fail_in(Status::reserved_bits_set, c, at_coding, ch + "reserved Value_Coding " + std::to_string(p[at_coding]));
       codings_[i] = static_cast<internal::ValueCoding>(p[at_coding]);
+    }
+    if (major_ >= 3) {
+      const size_t at_bytes = 18 * channels + i;
+      residual_bytes_[i] = p[at_bytes];
+      if (residual_bytes_[i] > internal::kMaxResidualBytes || (count == 0 && residual_bytes_[i] != 0))
+        return fail_in(Status::corrupt, c, at_bytes, ch + "Residual_Bytes must be at most 8, and 0 without keys");
     }
     internal::SourceChannel& t = parts.channels[i];
     t.first_key = key_sum;
@@ -483,15 +500,9 @@ Status Loader::parse_kval(const Content& c, ClipSource& parts) {
     at += static_cast<size_t>(size[k]);
   }
   parts.q.resize(static_cast<size_t>(key_count_));  // key_count_ == size[0] <= c.size
-  int64_t* out = parts.q.data();
   size_t pos[internal::kMaxVarint64Bytes] = {};
   for (size_t ch = 0; ch < parts.channels.size(); ++ch) {
     const internal::SourceChannel& t = parts.channels[ch];
-    const double step = t.step;
-    const internal::ValueCoding coding = codings_[ch];
-    const uint32_t* kf = parts.frames.data() + t.first_key;  // KTIM is parsed before KVAL
-    // 1.x stores deltas up to 2^54; 2.x residuals up to 2^57, so |prediction + residual| < 2^58.
-    const uint64_t max_residual = major_ >= 2 ? internal::kMaxAbsResidual : internal::kMaxAbsDelta;
     int64_t q = 0, q_prev = 0;
     for (uint32_t i = 0; i < t.key_count; ++i) {
       const size_t first_at = base[0] + pos[0];
@@ -515,23 +526,57 @@ Status Loader::parse_kval(const Content& c, ClipSource& parts) {
           }
         }
       }
-      // zigzag: |r| = (v + 1) / 2 without overflow.
-      if ((v >> 1) + (v & 1) > max_residual)
-        return fail_in(Status::corrupt, c, first_at,
-                       "channel " + std::to_string(ch) + (major_ >= 2 ? ": a residual beyond 2^57" : ": a delta beyond 2^54"));
-      const int64_t predicted = internal::predict_q(coding, kf, i, q, q_prev);
-      q_prev = q;
-      q = predicted + internal::zigzag_decode(v);
-      if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ)
-        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": |q| > 2^53");
-      const float value = dequantize(q, step);
-      if (!std::isfinite(value))
-        return fail_in(Status::corrupt, c, first_at, "channel " + std::to_string(ch) + ": a key value is not finite");
-      out[t.first_key + i] = q;
+      if (Status st = residual_to_q(c, first_at, ch, i, v, q, q_prev, parts); st != Status::ok) return st;
     }
   }
   for (uint8_t k = 0; k < count; ++k)
     if (pos[k] != size[k]) return fail_in(Status::corrupt, c, base[k] + pos[k], "plane bytes left over");
+  return Status::ok;
+}
+
+Status Loader::residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i, uint64_t v, int64_t& q,
+                             int64_t& q_prev, ClipSource& parts) {
+  const internal::SourceChannel& t = parts.channels[ch];
+  // 1.x stores deltas up to 2^54; 2.x and 3.x residuals up to 2^57, so |prediction + residual|
+  // < 2^58. zigzag: |r| = (v + 1) / 2 without overflow.
+  const uint64_t max_residual = major_ >= 2 ? internal::kMaxAbsResidual : internal::kMaxAbsDelta;
+  if ((v >> 1) + (v & 1) > max_residual)
+    return fail_in(Status::corrupt, c, at,
+                   "channel " + std::to_string(ch) + (major_ >= 2 ? ": a residual beyond 2^57" : ": a delta beyond 2^54"));
+  const uint32_t* kf = parts.frames.data() + t.first_key;  // KTIM is parsed before KVAL
+  const int64_t predicted = internal::predict_q(codings_[ch], kf, i, q, q_prev);
+  q_prev = q;
+  q = predicted + internal::zigzag_decode(v);
+  if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ)
+    return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": |q| > 2^53");
+  if (!std::isfinite(dequantize(q, t.step)))
+    return fail_in(Status::corrupt, c, at, "channel " + std::to_string(ch) + ": a key value is not finite");
+  parts.q[t.first_key + i] = q;
+  return Status::ok;
+}
+
+Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
+  // Plane k: byte k of every residual of the channels with Residual_Bytes > k (section 4.5).
+  const size_t channels = parts.channels.size();
+  uint64_t size[internal::kMaxResidualBytes] = {};
+  for (size_t ch = 0; ch < channels; ++ch)
+    for (uint32_t k = 0; k < residual_bytes_[ch]; ++k) size[k] += parts.channels[ch].key_count;
+  uint64_t total = 0;
+  size_t at[internal::kMaxResidualBytes];  // where each plane's next byte is
+  for (uint32_t k = 0; k < internal::kMaxResidualBytes; ++k) at[k] = static_cast<size_t>(total), total += size[k];
+  if (total != c.size)
+    return fail_in(Status::corrupt, c, 0,
+                   "KVAL must hold " + std::to_string(total) + " bytes (the channels' keys times their Residual_Bytes)");
+  parts.q.resize(static_cast<size_t>(key_count_));
+  for (size_t ch = 0; ch < channels; ++ch) {
+    const uint32_t bytes = residual_bytes_[ch];
+    int64_t q = 0, q_prev = 0;
+    for (uint32_t i = 0; i < parts.channels[ch].key_count; ++i) {
+      uint64_t v = 0;
+      for (uint32_t k = 0; k < bytes; ++k) v |= uint64_t(c.data[at[k]++]) << (8 * k);
+      if (Status st = residual_to_q(c, bytes ? at[0] - 1 : 0, ch, i, v, q, q_prev, parts); st != Status::ok) return st;
+    }
+  }
   return Status::ok;
 }
 
@@ -556,7 +601,10 @@ Status Loader::run(ClipSource& parts) {
           case 1: s = get_content(e, "SKEL", c); if (s == Status::ok) s = parse_skel(c, parts); break;
           case 2: s = get_content(e, "CHAN", c); if (s == Status::ok) s = parse_chan(c, parts); break;
           case 3: s = get_content(e, "KTIM", c); if (s == Status::ok) s = parse_ktim(c, parts); break;
-          default: s = get_content(e, "KVAL", c); if (s == Status::ok) s = parse_kval(c, parts); break;
+          default:
+            s = get_content(e, "KVAL", c);
+            if (s == Status::ok) s = major_ >= 3 ? parse_kval_fixed(c, parts) : parse_kval(c, parts);
+            break;
         }
         if (s != Status::ok) return s;
       }
