@@ -31,10 +31,8 @@ class ByteReader {
   ByteReader(const uint8_t* data, size_t size) noexcept : data_(data), size_(size) {}
 
   size_t pos() const noexcept { return pos_; }
-  size_t size() const noexcept { return size_; }
   size_t remaining() const noexcept { return size_ - pos_; }
   bool at_end() const noexcept { return pos_ == size_; }
-  const uint8_t* data() const noexcept { return data_; }
 
   // Each returns false (and leaves the position unchanged) when fewer bytes remain.
   template <typename T>

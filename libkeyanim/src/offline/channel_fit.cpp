@@ -177,12 +177,6 @@ float CurveFit::best_s() const {
   return float(std::clamp(num / den, 0.0, 1.0));
 }
 
-double CurveFit::max_ratio() const {
-  double r = 0.0;
-  for (uint32_t f = first_; f != kNone && next_[f] != kNone; f = next_[f]) r = std::max(r, seg_ratio_[f]);
-  return r;
-}
-
 EncodedChannel CurveFit::result(float tension) const {
   EncodedChannel ch;
   ch.interp = interp_;

@@ -33,7 +33,6 @@ class CurveFit {
   float best_s() const;
 
   size_t key_count() const { return count_; }
-  double max_ratio() const;
   EncodedChannel result(float tension) const;
 
  private:

@@ -129,16 +129,11 @@ inline int32_t unzigzag32(uint64_t u) noexcept {
   return static_cast<int32_t>(static_cast<uint32_t>(u >> 1) ^ (0u - static_cast<uint32_t>(u & 1)));
 }
 
-template <bool kPopcnt>
-[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint32_t t, Window& w) noexcept {
-  uint64_t mask;
-  std::memcpy(&mask, rec, 8);
-  const uint32_t vw = rec[8], kw = rec[9];
-  // The four context frames, from one load when they fit 64 bits (offsets below 2^15).
-  int32_t c[4];
-  if (kw <= 16) {
+// The four context frames of a record (relative to the block's start).
+[[gnu::always_inline]] inline void read_context(const uint8_t* rec, uint32_t kw, int32_t* c) noexcept {
+  if (kw <= 16) {  // one load: offsets below 2^15, the usual case
     uint64_t x;
-    std::memcpy(&x, rec + 10, 8);
+    std::memcpy(&x, rec + kRecordBitsAt / 8, 8);
     const uint64_t m = (uint64_t(1) << kw) - 1;
     c[0] = unzigzag32(x & m);
     c[1] = unzigzag32((x >> kw) & m);
@@ -149,8 +144,16 @@ template <bool kPopcnt>
   }
   c[2] += static_cast<int32_t>(kBlockFrames);
   c[3] += static_cast<int32_t>(kBlockFrames);
+}
+
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint32_t t, Window& w) noexcept {
+  uint64_t mask;
+  std::memcpy(&mask, rec, 8);
+  const uint32_t vw = rec[8], kw = rec[9];
   // Keys up to t (bits 0..t) and after it; k_j, k_{j-1} are the highest keys at or below t,
-  // k_{j+1}, k_{j+2} the lowest above, else the context keys before or after the block.
+  // k_{j+1}, k_{j+2} the lowest above, else the context keys before or after the block (read
+  // only then: in a dense channel two keys on each side are the usual case).
   const uint64_t upto = t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1;
   const uint64_t below = mask & upto;
   const uint64_t above = mask & ~upto;
@@ -158,16 +161,26 @@ template <bool kPopcnt>
   const int32_t top = top_bit(below | 1);  // | 1: defined when below is 0 (then unused)
   const uint64_t below_rest = below & ~(uint64_t(1) << top);
   const uint64_t above_rest = above & (above - 1);
-  w.frame[0] = below_rest ? top_bit(below_rest | 1) : (below ? c[1] : c[0]);
-  w.frame[1] = below ? top : c[1];
-  w.frame[2] = above ? low_bit(above | (uint64_t(1) << 63)) : c[2];
-  w.frame[3] = above_rest ? low_bit(above_rest | (uint64_t(1) << 63)) : (above ? c[2] : c[3]);
+  const uint64_t high = uint64_t(1) << 63;  // keeps low_bit defined (then unused)
+  if (below_rest != 0 && above_rest != 0) [[likely]] {
+    w.frame[0] = top_bit(below_rest);
+    w.frame[1] = top;
+    w.frame[2] = low_bit(above);
+    w.frame[3] = low_bit(above_rest);
+  } else {
+    int32_t c[4];
+    read_context(rec, kw, c);
+    w.frame[0] = below_rest ? top_bit(below_rest | 1) : (below ? c[1] : c[0]);
+    w.frame[1] = below ? top : c[1];
+    w.frame[2] = above ? low_bit(above | high) : c[2];
+    w.frame[3] = above_rest ? low_bit(above_rest | high) : (above ? c[2] : c[3]);
+  }
   // Values: two context keys, then `count` keys up to t; key j-1 is value `count`.
   const uint64_t base_at = kRecordBitsAt + 4 * uint64_t(kw);
   w.base = read_bits(rec, base_at, base_bits);
   w.value_bits = vw;
   const uint64_t at = base_at + base_bits + uint64_t(count) * vw;
-  if (vw <= 28) {  // two loads, two values each
+  if (vw <= 28) [[likely]] {  // two loads, two values each
     const uint64_t m = (uint64_t(1) << vw) - 1;
     uint64_t x, y;
     std::memcpy(&x, rec + (at >> 3), 8);

@@ -73,12 +73,23 @@ Position position(const Image& img, float f) noexcept {
   for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(w.value[k]), cv.step);
 }
 
+// The image's arrays for one block, loaded once per pose rather than once per curve.
+struct BlockView {
+  const uint8_t* payload;
+  const uint32_t* offsets;  // the block's row of record offsets
+  const Curve* curves;
+};
+
+BlockView block_view(const Image& img, const Position& at) noexcept {
+  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.curves.size(), img.curves.data()};
+}
+
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void gather(const Image& img, uint32_t curve, const Position& at, Batch& b,
+[[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t curve, uint32_t t, Batch& b,
                                           uint32_t i) noexcept {
-  const Curve& cv = img.curves[curve];
+  const Curve& cv = v.curves[curve];
   Window w;
-  read_window<kPopcnt>(img.record(at.block, curve), cv.base_bits, at.t, w);
+  read_window<kPopcnt>(v.payload + v.offsets[curve], cv.base_bits, t, w);
   std::memcpy(b.frames[i], w.frame, sizeof w.frame);
   dequantize4(w, cv, b.values[i]);
 }
@@ -150,6 +161,7 @@ template <bool kPopcnt>
   Batch b;
   alignas(16) float res[kChunk];
   const Position at = position(img, f);
+  const BlockView view = block_view(img, at);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
     for (uint32_t i = 0; i < m; ++i) {
@@ -158,7 +170,7 @@ template <bool kPopcnt>
       if (curve == kNoCurve) {
         set_fixed(b, i, img.fixed_value[c]);
       } else {
-        gather<kPopcnt>(img, curve, at, b, i);
+        gather<kPopcnt>(view, curve, at.t, b, i);
         copy_facts(img, curve, b, i);
       }
     }
@@ -178,9 +190,10 @@ template <bool kPopcnt>
   Batch b;
   alignas(16) float res[kChunk];
   const Position at = position(img, f);
+  const BlockView view = block_view(img, at);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
-    for (uint32_t i = 0; i < m; ++i) gather<kPopcnt>(img, base + i, at, b, i);
+    for (uint32_t i = 0; i < m; ++i) gather<kPopcnt>(view, base + i, at.t, b, i);
     const uint32_t lanes = (m + 3) & ~3u;
     for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
     const Facts x{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
@@ -286,8 +299,9 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
   uint64_t mask;
   std::memcpy(&mask, rec, 8);
   const uint32_t kw = rec[9];
-  for (uint32_t k = 0; k < 2; ++k)
-    s.after[k] = unzigzag32(read_bits(rec, kRecordBitsAt + (2 + k) * kw, kw)) + start + int32_t(kBlockFrames);
+  int32_t c[4];
+  read_context(rec, kw, c);
+  s.after[0] = c[2] + start, s.after[1] = c[3] + start;
   const uint64_t upto = at.t >= 63 ? ~uint64_t(0) : (uint64_t(2) << at.t) - 1;
   const uint64_t above = mask & ~upto;
   const uint64_t above_rest = above & (above - 1);
