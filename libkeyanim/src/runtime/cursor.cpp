@@ -2,6 +2,7 @@
 // inside the same segments costs only the polynomial) and a stream over its record (so the
 // next segment costs one key).
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <new>
 
@@ -48,23 +49,48 @@ bool Cursor::prepared_for(const Clip& clip) const noexcept {
 namespace internal {
 namespace {
 
-void store(Cursor::State& st, uint32_t i, const Segment& s) noexcept {
-  st.lo[i] = s.lo, st.hi[i] = s.hi, st.k0[i] = s.k0, st.k1[i] = s.k1;
-  st.p0[i] = s.o.p0, st.d[i] = s.o.d, st.m0[i] = s.o.m0, st.m1[i] = s.o.m1, st.value[i] = s.value;
-  st.linear[i] = s.linear ? ~0u : 0u;
-  st.direct[i] = s.direct ? ~0u : 0u;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// A state where curve i's value is `value` for lo <= f < hi.
+void set_direct(Cursor::State& st, uint32_t i, float value, float lo, float hi) noexcept {
+  st.lo[i] = lo, st.hi[i] = hi, st.value[i] = value;
+  st.k0[i] = 0.0f, st.k1[i] = 1.0f, st.p0[i] = st.d[i] = st.m0[i] = st.m1[i] = 0.0f;
+  st.linear[i] = 0u, st.direct[i] = ~0u;
 }
 
-// Curve i's segment at f: a few keys forward on its stream in playback, a seek otherwise.
+// Curve i's state at f: clamped outside its keys; inside, its segment from the stream (a few
+// keys forward in playback, a seek otherwise) with the operands of Appendix A.
 void refresh(const Image& img, Cursor::State& st, uint32_t i, float f) noexcept {
-  Segment s;
-  if (clamped_segment(img, i, f, s)) return store(st, i, s);
+  const float first = img.first_frame[i], last = img.last_frame[i];
+  if (!(f > first)) return set_direct(st, i, img.first_value[i], -kInf, std::nextafter(first, kInf));
+  if (f >= last) return set_direct(st, i, img.last_value[i], last, kInf);
   KeyStream& ks = st.streams[i];
   bool ok = f >= static_cast<float>(ks.k[1]) && ks.block >= 0;  // forward, in a record
   while (ok && static_cast<float>(ks.k[2]) <= f) ok = advance_stream(ks);
   if (!ok) seek_stream(img, i, f, ks);
-  stream_segment(img, i, ks, f, s);
-  store(st, i, s);
+  // Key frames are exact in binary32 (below 2^24), so u from them equals the sampler's (both
+  // round f - K_j once); lengths are rounded once from the integer differences.
+  const int32_t* k = ks.k;
+  const float k0 = static_cast<float>(k[1]), k1 = static_cast<float>(k[2]);
+  const float len = static_cast<float>(k[2] - k[1]);
+  const bool adjusted = img.rule == TangentRule::step_adjusted;
+  const float a0 = adjusted ? tangent_scale(len, static_cast<float>(k[1] - k[0])) : 1.0f;
+  const float a1 = adjusted ? tangent_scale(len, static_cast<float>(k[3] - k[2])) : 1.0f;
+  const Operands<float> o = cardinal_operands(ks.v[0], ks.v[1], ks.v[2], ks.v[3], img.curve_s[i], a0, a1);
+  st.k0[i] = k0, st.k1[i] = k1, st.p0[i] = o.p0, st.d[i] = o.d, st.m0[i] = o.m0, st.m1[i] = o.m1;
+  st.value[i] = o.p0;
+  st.linear[i] = img.curve_linear[i];
+  // At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's v_j, when the
+  // operands are finite and p0 is not -0 (-0 + +0 is +0); else K_j is a direct state of its own.
+  const bool exact_at_key = std::isfinite(o.d) && std::isfinite(o.m0) && std::isfinite(o.m1) &&
+                            !(o.p0 == 0.0f && std::signbit(o.p0));
+  if (exact_at_key) {
+    st.lo[i] = k0, st.hi[i] = k1, st.direct[i] = 0u;
+  } else if (f == k0) {
+    st.lo[i] = k0, st.hi[i] = std::nextafter(k0, kInf), st.direct[i] = ~0u;
+  } else {
+    st.lo[i] = std::nextafter(k0, kInf), st.hi[i] = k1, st.direct[i] = 0u;
+  }
 }
 
 }  // namespace

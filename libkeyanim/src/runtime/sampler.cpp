@@ -247,44 +247,6 @@ void sample_range(const Image& img, float f, uint32_t first, uint32_t count, flo
   }
 }
 
-bool clamped_segment(const Image& img, uint32_t curve, float f, Segment& s) noexcept {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  const float first = img.first_frame[curve], last = img.last_frame[curve];
-  if (!(f > first)) {  // f == K_0 included
-    s = Segment{};
-    s.lo = -kInf, s.hi = std::nextafter(first, kInf), s.value = img.first_value[curve];
-    return true;
-  }
-  if (f >= last) {
-    s = Segment{};
-    s.lo = last, s.hi = kInf, s.value = img.last_value[curve];
-    return true;
-  }
-  return false;
-}
-
-void stream_segment(const Image& img, uint32_t curve, const KeyStream& ks, float f, Segment& s) noexcept {
-  // Key frames are exact in binary32 (below 2^24), so u from them equals the sampler's (both
-  // round f - K_j once); lengths are rounded once from the integer differences.
-  const int32_t* k = ks.k;
-  const float k0 = static_cast<float>(k[1]), k1 = static_cast<float>(k[2]);
-  s.k0 = k0, s.k1 = k1, s.hi = k1;
-  s.linear = img.curve_linear[curve] != 0;
-  const float len = static_cast<float>(k[2] - k[1]);
-  const bool adjusted = img.rule == TangentRule::step_adjusted;
-  const float a0 = adjusted ? tangent_scale(len, static_cast<float>(k[1] - k[0])) : 1.0f;
-  const float a1 = adjusted ? tangent_scale(len, static_cast<float>(k[3] - k[2])) : 1.0f;
-  s.o = cardinal_operands(ks.v[0], ks.v[1], ks.v[2], ks.v[3], img.curve_s[curve], a0, a1);
-  s.value = s.o.p0;
-  // At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's v_j, when the
-  // operands are finite and p0 is not -0 (-0 + +0 is +0); else K_j is a direct state of its own.
-  const bool exact_at_key = std::isfinite(s.o.d) && std::isfinite(s.o.m0) && std::isfinite(s.o.m1) &&
-                            !(s.o.p0 == 0.0f && std::signbit(s.o.p0));
-  s.direct = !exact_at_key && f == k0;
-  s.lo = exact_at_key || s.direct ? k0 : std::nextafter(k0, std::numeric_limits<float>::infinity());
-  if (s.direct) s.hi = std::nextafter(k0, std::numeric_limits<float>::infinity());
-}
-
 void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept {
   const Position at = position(img, f);
   const Curve& cv = img.curves[curve];

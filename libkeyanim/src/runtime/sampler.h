@@ -53,21 +53,4 @@ inline bool advance_stream(KeyStream& s) noexcept {
   return true;
 }
 
-// The state of one curve for positions near f: while lo <= f < hi its value is `value` if
-// `direct`, else the segment polynomial at segment_u(f, k0, k1) (hermite, or linear_value
-// when `linear`). Computed with the same building blocks as sample_all, so the values are
-// identical.
-struct Segment {
-  float lo = 0.0f, hi = 0.0f;
-  float k0 = 0.0f, k1 = 1.0f;
-  Operands<float> o{};
-  float value = 0.0f;
-  bool direct = true;
-  bool linear = false;
-};
-// The clamped states (f <= K_0 or f >= K_{n-1}); false for positions between.
-bool clamped_segment(const Image& img, uint32_t curve, float f, Segment& out) noexcept;
-// The segment of a stream positioned at f.
-void stream_segment(const Image& img, uint32_t curve, const KeyStream& s, float f, Segment& out) noexcept;
-
 }  // namespace keyanim::internal
