@@ -569,13 +569,31 @@ Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
                    "KVAL must hold " + std::to_string(total) + " bytes (the channels' keys times their Residual_Bytes)");
   parts.q.resize(static_cast<size_t>(key_count_));
   for (size_t ch = 0; ch < channels; ++ch) {
+    const internal::SourceChannel& t = parts.channels[ch];
     const uint32_t bytes = residual_bytes_[ch];
-    int64_t q = 0, q_prev = 0;
-    for (uint32_t i = 0; i < parts.channels[ch].key_count; ++i) {
+    const uint8_t* plane[internal::kMaxResidualBytes];
+    for (uint32_t k = 0; k < bytes; ++k) plane[k] = c.data + at[k], at[k] += t.key_count;
+    const uint32_t* kf = parts.frames.data() + t.first_key;  // KTIM is parsed before KVAL
+    int64_t* out = parts.q.data() + t.first_key;
+    int64_t q = 0, q_prev = 0, lo = 0, hi = 0;
+    for (uint32_t i = 0; i < t.key_count; ++i) {
       uint64_t v = 0;
-      for (uint32_t k = 0; k < bytes; ++k) v |= uint64_t(c.data[at[k]++]) << (8 * k);
-      if (Status st = residual_to_q(c, bytes ? at[0] - 1 : 0, ch, i, v, q, q_prev, parts); st != Status::ok) return st;
+      for (uint32_t k = 0; k < bytes; ++k) v |= uint64_t(plane[k][i]) << (8 * k);
+      // |r| = (v + 1) / 2 without overflow; after this check |prediction + r| < 2^58.
+      if ((v >> 1) + (v & 1) > internal::kMaxAbsResidual) [[unlikely]]
+        return fail_in(Status::corrupt, c, plane[0] + i - c.data, "channel " + std::to_string(ch) + ": a residual beyond 2^57");
+      const int64_t predicted = internal::predict_q(codings_[ch], kf, i, q, q_prev);
+      q_prev = q;
+      q = predicted + internal::zigzag_decode(v);
+      if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ) [[unlikely]]
+        return fail_in(Status::corrupt, c, plane[0] + i - c.data, "channel " + std::to_string(ch) + ": |q| > 2^53");
+      out[i] = q;
+      lo = i ? std::min(lo, q) : q, hi = i ? std::max(hi, q) : q;
     }
+    // q x step is monotone in q, so the extremes tell whether every value is finite.
+    if (t.key_count && (!std::isfinite(dequantize(lo, t.step)) || !std::isfinite(dequantize(hi, t.step))))
+      return fail_in(Status::corrupt, c, bytes ? plane[0] - c.data : 0,
+                     "channel " + std::to_string(ch) + ": a key value is not finite");
   }
   return Status::ok;
 }
