@@ -216,9 +216,10 @@ EncodedClip vector_predict() {
 
 // Version 3.0 adds nothing for blocks to the file, but a decoder's runtime layout (keyanim's:
 // 64-frame blocks, spec Appendix F) meets its limits here: keys on both sides of every block
-// boundary, a block full of keys, gaps spanning many blocks (context frames 2^15 and more
-// away), curves that start and end inside blocks, 2 keys in adjacent blocks, values across
-// the whole +-2^53 range, a uniform-rule twin is v3_uniform.
+// boundary, a block full of keys, a gap of 40 000 frames (context frames 2^15 and more away),
+// curves that start and end inside blocks, 2 keys in adjacent blocks, values across the whole
+// +-2^53 range; and a sparse channel, which keyanim keeps as a plain list of keys. (Every other
+// curve has keys on the last 300 frames too, so that keyanim gives it records.)
 EncodedClip vector_blocks() {
   EncodedClip c;
   c.skeleton.joints = {
@@ -230,29 +231,42 @@ EncodedClip vector_blocks() {
   c.frame_count = 70000;
   c.frame_time = 1.0 / 120.0;
   c.tangent_rule = TangentRule::step_adjusted;
-  std::vector<uint32_t> edges = {0, 1, 62, 63, 64, 65, 127, 128, 191, 192, 255, 256, 1000, 69998, 69999};
+  // Keys at frames 69700 .. 69999 after a curve's own, with values from `seed`.
+  auto with_tail = [](std::vector<uint32_t> frames, std::vector<int64_t> values, int64_t seed) {
+    for (uint32_t f = 69700; f < 70000; ++f) {
+      if (!frames.empty() && frames.back() >= f) continue;
+      frames.push_back(f);
+      values.push_back((int64_t(f) * (seed + 7)) % 23 - 11);
+    }
+    return std::make_pair(frames, values);
+  };
+  auto add = [&](Interpolation interp, float tension, double step, std::vector<uint32_t> frames,
+                 std::vector<int64_t> values, int64_t seed) {
+    auto [f, v] = with_tail(std::move(frames), std::move(values), seed);
+    c.channels.push_back(chan(interp, tension, step, f, v));
+  };
+  std::vector<uint32_t> edges = {0, 1, 62, 63, 64, 65, 127, 128, 191, 192, 255, 256, 1000};
   std::vector<int64_t> ev;
   for (size_t i = 0; i < edges.size(); ++i) ev.push_back((int64_t(i) * 37) % 11 * 100 - 500);
-  c.channels.push_back(chan(kCard, 0.0f, 0.01, edges, ev));
+  add(kCard, 0.0f, 0.01, edges, ev, 1);
   std::vector<uint32_t> full;
   std::vector<int64_t> fv;
   for (uint32_t f = 128; f < 256; ++f) full.push_back(f), fv.push_back(int64_t(f % 7) * 13 - int64_t(f / 9));
-  full.push_back(69999), fv.push_back(3);
-  c.channels.push_back(chan(kCard, 0.25f, 0.02, full, fv));
-  c.channels.push_back(chan(kCard, 0.0f, 0.1, {0, 5, 40000, 69999}, {10, -20, 30, -40}));  // far context
-  c.channels.push_back(chan(kCard, -0.5f, 0.05, {70, 75, 200}, {5, -5, 15}));  // starts and ends inside blocks
-  c.channels.push_back(chan(kLin, 0.0f, 0.1, {63, 64}, {-1000, 1000}));        // two keys, adjacent blocks
+  add(kCard, 0.25f, 0.02, full, fv, 2);                             // blocks 2 and 3 full
+  add(kCard, 0.0f, 0.1, {0, 5, 40000}, {10, -20, 30}, 3);           // a 40 000-frame gap
+  add(kCard, -0.5f, 0.05, {70, 75, 200}, {5, -5, 15}, 4);            // starts inside a block
+  add(kLin, 0.0f, 0.1, {63, 64}, {-1000, 1000}, 5);                  // two keys, adjacent blocks
   const int64_t big = int64_t(1) << 53;
-  c.channels.push_back(chan(kCard, 0.0f, 1e-20, {0, 64, 65, 129, 69999}, {big, -big, big - 1, -big + 1, 0}));
+  add(kCard, 0.0f, 1e-20, {0, 64, 65, 129}, {big, -big, big - 1, -big + 1}, 6);
   c.channels.push_back(chan(kCard, 0.0f, 0.5, {}, {}));      // zero
   c.channels.push_back(chan(kCard, 0.0f, 0.5, {33}, {-7}));  // constant
-  std::vector<uint32_t> sparse;
+  std::vector<uint32_t> sparse;                               // a list curve: 15 keys
   std::vector<int64_t> sv;
   for (uint32_t f = 0; f < 70000; f += 4999) sparse.push_back(f), sv.push_back(int64_t(f / 4999) * int64_t(f / 4999) * 50);
   sparse.push_back(69999), sv.push_back(0);
   c.channels.push_back(chan(kCard, 0.1f, 0.001, sparse, sv));
-  c.channels.push_back(chan(kLin, 0.0f, 0.25, {100, 160, 161, 224, 288, 289, 352}, {1, 2, 3, 4, 5, 6, 7}));
-  c.channels.push_back(chan(kCard, 0.0f, 0.125, {0, 69999}, {-3, 3}));
+  add(kLin, 0.0f, 0.25, {100, 160, 161, 224, 288, 289, 352}, {1, 2, 3, 4, 5, 6, 7}, 8);
+  c.channels.push_back(chan(kCard, 0.0f, 0.125, {0, 69999}, {-3, 3}));  // a list curve: 2 keys
   return c;
 }
 

@@ -78,8 +78,13 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
     values[0] = img.fixed_value[c];
     return Status::ok;
   }
-  // Walk the records block by block: each lists its block's keys in its mask.
   const internal::Curve& cv = img.curves[curve];
+  if (curve >= img.block_curves) {  // a list curve
+    std::copy_n(img.list_frames.data() + cv.list_first, n, frames.data());
+    std::copy_n(img.list_values.data() + cv.list_first, n, values.data());
+    return Status::ok;
+  }
+  // Walk the records block by block: each lists its block's keys in its mask.
   uint32_t k = 0;
   for (uint32_t b = 0; b < img.block_count && k < n; ++b) {
     const uint8_t* rec = img.record(b, curve);

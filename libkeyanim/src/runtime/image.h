@@ -47,6 +47,7 @@ struct Curve {
   double step = 1.0;
   uint32_t channel = 0;  // output column
   uint32_t base_bits = 0;  // wc
+  uint32_t list_first = 0, list_count = 0;  // a list curve's keys in Image::list_*
 };
 
 struct Image {
@@ -71,24 +72,32 @@ struct Image {
   std::vector<uint32_t> fixed_channels;  // channels with fewer than two keys, in order
 
   // Curves and their records. The per-curve arrays are separate so that 4 curves load at once.
+  // Curves [0, block_curves) have a record per block; the others, sparse ones (fewer keys than
+  // a quarter of the blocks), keep a plain list of keys instead, so that the image stays
+  // linear in the keys whatever the frame count.
   std::vector<Curve> curves;
+  uint32_t block_curves = 0;
+  std::vector<uint32_t> list_frames;     // list curves' key frames, curve after curve
+  std::vector<float> list_values;        // and their values
   std::vector<float> curve_s;            // (1 - tension) / 2
   std::vector<float> first_frame, last_frame;  // K_0 and K_{n-1}
   std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
   std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
   uint32_t block_count = 0;
   uint32_t max_window = 0;              // most keys any record holds (block keys + 4)
-  std::vector<uint32_t> record_offset;  // [block * curves.size() + curve]: byte offset in payload
+  std::vector<uint32_t> record_offset;  // [block * block_curves + curve]: byte offset in payload
   std::vector<uint8_t> payload;         // records, then kPayloadPadding zero bytes
 
   const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
-    return payload.data() + record_offset[size_t(block) * curves.size() + curve];
+    return payload.data() + record_offset[size_t(block) * block_curves + curve];
   }
   size_t memory_bytes() const noexcept;
 };
 
 // Builds the image of a valid source (its keys decoded, every rule checked).
 std::shared_ptr<const Image> build_image(ClipSource&& source);
+// Whether a curve of n keys over `blocks` blocks is kept as a list (see Image::curves).
+inline bool is_list_curve(uint64_t n, uint64_t blocks) noexcept { return 4 * n < blocks; }
 
 // `width` bits (<= 57) starting `bit` bits after p, least significant bit first. Reads the 8
 // bytes from p + bit / 8.

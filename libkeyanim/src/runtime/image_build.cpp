@@ -117,6 +117,7 @@ size_t Image::memory_bytes() const noexcept {
   n += curve_s.capacity() * sizeof(float) + first_frame.capacity() * sizeof(float) +
        last_frame.capacity() * sizeof(float) + first_value.capacity() * sizeof(float) +
        last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t);
+  n += list_frames.capacity() * sizeof(uint32_t) + list_values.capacity() * sizeof(float);
   n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
   return n;
 }
@@ -143,36 +144,51 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   img->curve_of.assign(channels, kNoCurve);
   img->fixed_value.assign(channels, 0.0f);
   img->fixed_frame.assign(channels, 0);
-  for (size_t c = 0; c < channels; ++c) {
-    const SourceChannel& sc = src.channels[c];
-    img->interp[c] = sc.interp;
-    img->tension[c] = sc.tension;
-    img->key_count[c] = sc.key_count;
-    if (sc.key_count < 2) {
-      if (sc.key_count == 1) {
-        img->fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
-        img->fixed_frame[c] = src.frames[sc.first_key];
+  const uint64_t blocks = (uint64_t(src.frame_count) + kBlockFrames - 1) / kBlockFrames;
+  // Block curves first, then list curves (two passes over the channels).
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t c = 0; c < channels; ++c) {
+      const SourceChannel& sc = src.channels[c];
+      if (pass == 0) {
+        img->interp[c] = sc.interp;
+        img->tension[c] = sc.tension;
+        img->key_count[c] = sc.key_count;
       }
-      img->fixed_channels.push_back(static_cast<uint32_t>(c));
-      continue;
+      if (sc.key_count < 2) {
+        if (pass == 1) continue;
+        if (sc.key_count == 1) {
+          img->fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
+          img->fixed_frame[c] = src.frames[sc.first_key];
+        }
+        img->fixed_channels.push_back(static_cast<uint32_t>(c));
+        continue;
+      }
+      const uint32_t n = sc.key_count;
+      if (is_list_curve(n, blocks) != (pass == 1)) continue;
+      const int64_t* q = src.q.data() + sc.first_key;
+      const uint32_t* k = src.frames.data() + sc.first_key;
+      Curve cv;
+      cv.step = sc.step;
+      const auto [lo, hi] = std::minmax_element(q, q + n);
+      cv.q_base = *lo;
+      cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
+      cv.channel = static_cast<uint32_t>(c);
+      if (pass == 1) {
+        cv.list_first = static_cast<uint32_t>(img->list_frames.size());
+        cv.list_count = n;
+        img->list_frames.insert(img->list_frames.end(), k, k + n);
+        for (uint32_t i = 0; i < n; ++i) img->list_values.push_back(dequantize(q[i], sc.step));
+      }
+      img->curve_s.push_back(tension_to_s(sc.tension));
+      img->first_frame.push_back(static_cast<float>(k[0]));
+      img->last_frame.push_back(static_cast<float>(k[n - 1]));
+      img->first_value.push_back(dequantize(q[0], sc.step));
+      img->last_value.push_back(dequantize(q[n - 1], sc.step));
+      img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
+      img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
+      img->curves.push_back(cv);
     }
-    const int64_t* q = src.q.data() + sc.first_key;
-    const uint32_t* k = src.frames.data() + sc.first_key;
-    const uint32_t n = sc.key_count;
-    Curve cv;
-    cv.step = sc.step;
-    const auto [lo, hi] = std::minmax_element(q, q + n);
-    cv.q_base = *lo;
-    cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
-    cv.channel = static_cast<uint32_t>(c);
-    img->curve_s.push_back(tension_to_s(sc.tension));
-    img->first_frame.push_back(static_cast<float>(k[0]));
-    img->last_frame.push_back(static_cast<float>(k[n - 1]));
-    img->first_value.push_back(dequantize(q[0], sc.step));
-    img->last_value.push_back(dequantize(q[n - 1], sc.step));
-    img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
-    img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
-    img->curves.push_back(cv);
+    if (pass == 0) img->block_curves = static_cast<uint32_t>(img->curves.size());
   }
 
   const size_t nc = img->curves.size();
@@ -185,10 +201,11 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   img->first_value.resize(lanes, 0.0f);
   img->last_value.resize(lanes, 0.0f);
   img->curve_linear.resize(lanes, 0u);
-  img->block_count = nc == 0 ? 0 : (src.frame_count + kBlockFrames - 1) / kBlockFrames;
-  const size_t records = size_t(img->block_count) * nc;
+  img->block_count = nc == 0 ? 0 : static_cast<uint32_t>(blocks);
+  const size_t nb = img->block_curves;  // records: at most 4 per key of a block curve
+  const size_t records = size_t(img->block_count) * nb;
   std::vector<RecordPlan> plans(records);
-  for (size_t i = 0; i < nc; ++i) {
+  for (size_t i = 0; i < nb; ++i) {
     const Curve& cv = img->curves[i];
     const SourceChannel& sc = src.channels[cv.channel];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
@@ -198,7 +215,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
       while (first < keys.n && int64_t(keys.k[first]) < start) ++first;
       last = std::max(last, first);
       while (last < keys.n && int64_t(keys.k[last]) < start + kBlockFrames) ++last;
-      plans[size_t(b) * nc + i] = plan_record(keys, first, last, start, cv.q_base, cv.base_bits);
+      plans[size_t(b) * nb + i] = plan_record(keys, first, last, start, cv.q_base, cv.base_bits);
     }
   }
   // Offsets in block-major order; u32 offsets bound the payload (checked: 2^32 bytes is far
@@ -212,12 +229,12 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
     total += plans[r].size_bytes;
   }
   img->payload.assign(total + kPayloadPadding, 0);
-  for (size_t i = 0; i < nc; ++i) {
+  for (size_t i = 0; i < nb; ++i) {
     const Curve& cv = img->curves[i];
     const SourceChannel& sc = src.channels[cv.channel];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
     for (uint32_t b = 0; b < img->block_count; ++b) {
-      const size_t r = size_t(b) * nc + i;
+      const size_t r = size_t(b) * nb + i;
       write_record(img->payload.data() + img->record_offset[r], keys, plans[r], int64_t(b) << kBlockShift,
                    cv.q_base, cv.base_bits);
     }

@@ -81,7 +81,7 @@ struct BlockView {
 };
 
 BlockView block_view(const Image& img, const Position& at) noexcept {
-  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.curves.size(), img.curves.data()};
+  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_curves, img.curves.data()};
 }
 
 template <bool kPopcnt>
@@ -92,6 +92,39 @@ template <bool kPopcnt>
   read_window<kPopcnt>(v.payload + v.offsets[curve], cv.base_bits, t, w);
   std::memcpy(b.frames[i], w.frame, sizeof w.frame);
   dequantize4(w, cv, b.values[i]);
+}
+
+// A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
+// first or last segment outside the keys), with virtual keys beyond the ends as in records.
+struct ListWindow {
+  int64_t frame[4];
+  float value[4];
+  uint32_t j;  // index of key j in the list
+};
+
+void list_window(const Image& img, const Curve& cv, float f, ListWindow& w) noexcept {
+  const uint32_t* k = img.list_frames.data() + cv.list_first;
+  const float* v = img.list_values.data() + cv.list_first;
+  const uint32_t n = cv.list_count;
+  const float clamped = std::min(std::max(f, static_cast<float>(k[0])), static_cast<float>(k[n - 1]));
+  const uint32_t j = find_segment(k, n, clamped);
+  w.j = j;
+  w.frame[0] = j > 0 ? int64_t(k[j - 1]) : 2 * int64_t(k[0]) - int64_t(k[1]);
+  w.frame[1] = k[j];
+  w.frame[2] = k[j + 1];
+  w.frame[3] = j + 2 < n ? int64_t(k[j + 2]) : 2 * int64_t(k[n - 1]) - int64_t(k[n - 2]);
+  w.value[0] = v[j > 0 ? j - 1 : 0];
+  w.value[1] = v[j];
+  w.value[2] = v[j + 1];
+  w.value[3] = v[j + 2 < n ? j + 2 : n - 1];
+}
+
+void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b, uint32_t i) noexcept {
+  ListWindow w;
+  list_window(img, img.curves[curve], at.f, w);
+  const int64_t start = int64_t(at.block) << kBlockShift;  // frames relative to f's block, as records
+  for (int k = 0; k < 4; ++k) b.frames[i][k] = static_cast<int32_t>(w.frame[k] - start);
+  std::memcpy(b.values[i], w.value, sizeof w.value);
 }
 
 void set_fixed(Batch& b, uint32_t i, float v) noexcept {
@@ -170,7 +203,10 @@ template <bool kPopcnt>
       if (curve == kNoCurve) {
         set_fixed(b, i, img.fixed_value[c]);
       } else {
-        gather<kPopcnt>(view, curve, at.t, b, i);
+        if (curve < img.block_curves)
+          gather<kPopcnt>(view, curve, at.t, b, i);
+        else
+          gather_list(img, curve, at, b, i);
         copy_facts(img, curve, b, i);
       }
     }
@@ -193,7 +229,9 @@ template <bool kPopcnt>
   const BlockView view = block_view(img, at);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
-    for (uint32_t i = 0; i < m; ++i) gather<kPopcnt>(view, base + i, at.t, b, i);
+    const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
+    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, at.t, b, i);
+    for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
     const uint32_t lanes = (m + 3) & ~3u;
     for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
     const Facts x{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
@@ -248,8 +286,20 @@ void sample_range(const Image& img, float f, uint32_t first, uint32_t count, flo
 }
 
 void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept {
-  const Position at = position(img, f);
   const Curve& cv = img.curves[curve];
+  if (curve >= img.block_curves) {  // a list curve: the stream walks the list
+    ListWindow w;
+    list_window(img, cv, f, w);
+    for (int i = 0; i < 4; ++i) s.k[i] = static_cast<int32_t>(w.frame[i]), s.v[i] = w.value[i];
+    s.list = img.list_frames.data() + cv.list_first;
+    s.list_values = img.list_values.data() + cv.list_first;
+    s.list_count = cv.list_count;
+    s.list_next = w.j + 3;
+    s.block = 0;
+    return;
+  }
+  s.list = nullptr;
+  const Position at = position(img, f);
   const uint8_t* rec = img.record(at.block, curve);
   Window w;
   read_window<false>(rec, cv.base_bits, at.t, w);

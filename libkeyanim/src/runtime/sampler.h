@@ -30,6 +30,10 @@ struct KeyStream {
   int32_t block = -1;    // the record's block, -1 for none
   uint32_t value_bits = 0;
   uint32_t after_used = 0;  // context keys after the block already in k
+  // A list curve's stream (Image::curves): its keys, and the index of the next one to read.
+  const uint32_t* list = nullptr;
+  const float* list_values = nullptr;
+  uint32_t list_count = 0, list_next = 0;
 };
 
 // Positions the stream on the segment holding f (K_0 < f < K_{n-1}): reads f's record.
@@ -38,6 +42,14 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
 // has left the record's block: seek instead).
 inline bool advance_stream(KeyStream& s) noexcept {
   int32_t next;
+  if (s.list != nullptr) {  // the next key of the list; one virtual key after the last
+    const uint32_t n = s.list_count, i = s.list_next++;
+    if (i > n) return false;
+    next = i < n ? static_cast<int32_t>(s.list[i]) : 2 * static_cast<int32_t>(s.list[n - 1]) - static_cast<int32_t>(s.list[n - 2]);
+    s.k[0] = s.k[1], s.k[1] = s.k[2], s.k[2] = s.k[3], s.k[3] = next;
+    s.v[0] = s.v[1], s.v[1] = s.v[2], s.v[2] = s.v[3], s.v[3] = s.list_values[i < n ? i : n - 1];
+    return true;
+  }
   if (s.rest != 0) {
     next = static_cast<int32_t>(static_cast<uint32_t>(s.block) << kBlockShift) + low_bit(s.rest);
     s.rest &= s.rest - 1;
