@@ -23,4 +23,9 @@ inline std::vector<std::filesystem::path> corpus_bvh_files() {
   return files;
 }
 
+// The line a corpus test prints when it cannot run: CTest marks a test whose output holds it as
+// skipped (tests/CMakeLists.txt, SKIP_REGULAR_EXPRESSION), and scripts/test.sh says why.
+#define KEYANIM_CORPUS_SKIP_MARK "keyanim-corpus-skip"
+#define KEYANIM_SKIP_CORPUS_TEST(what) MESSAGE(KEYANIM_CORPUS_SKIP_MARK ": " << (what) << " not found")
+
 }  // namespace keyanim::test

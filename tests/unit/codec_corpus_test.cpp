@@ -36,7 +36,7 @@ TEST_SUITE("corpus") {
   TEST_CASE("every corpus file round-trips through .kanim within the default tolerance") {
     const auto files = keyanim::test::corpus_bvh_files();
     if (files.empty()) {
-      MESSAGE("corpus not found at " << keyanim::test::corpus_dir().string() << ": corpus tests skipped");
+      KEYANIM_SKIP_CORPUS_TEST(keyanim::test::corpus_dir().string());
       return;
     }
     for (const auto& path : files) {

@@ -232,7 +232,7 @@ TEST_CASE("shoulder Z rotation of a CMU clip: keys land on turning points") {
   const std::filesystem::path path = keyanim::test::corpus_dir() / "cmu" / "assimp__01_03.bvh";
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
-    MESSAGE("corpus file absent, skipped: " << path.string());
+    KEYANIM_SKIP_CORPUS_TEST(path.string());
     return;
   }
   keyanim::offline::Motion motion;
