@@ -58,6 +58,15 @@ struct Image {
   TangentRule rule = TangentRule::step_adjusted;
   Skeleton skeleton;
   std::vector<float> node_offset;  // 3 per node: OFFSET in binary32, for poses
+  // Poses: each node's channels as (column, axis, rotation?) steps, nodes one after the other;
+  // node i's steps are pose_steps[pose_first[i] .. pose_first[i + 1]).
+  struct PoseStep {
+    uint32_t column;
+    uint8_t axis;      // 0 X, 1 Y, 2 Z
+    uint8_t rotation;  // 1 rotation, 0 position
+  };
+  std::vector<PoseStep> pose_steps;
+  std::vector<uint32_t> pose_first;
   std::string notes;
   uint64_t total_keys = 0;
   uint64_t id = 0;  // distinguishes clips for cursors (an address can be reused)

@@ -110,7 +110,8 @@ size_t Image::memory_bytes() const noexcept {
     n += j.name.capacity() > 15 ? j.name.capacity() : 0;  // beyond the small-string buffer
     n += j.channels.capacity() * sizeof(ChannelType);
   }
-  n += node_offset.capacity() * sizeof(float);
+  n += node_offset.capacity() * sizeof(float) + pose_steps.capacity() * sizeof(PoseStep) +
+       pose_first.capacity() * sizeof(uint32_t);
   n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
   n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
   n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
@@ -130,8 +131,14 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   img->frame_time = src.frame_time;
   img->rule = src.rule;
   img->skeleton = std::move(src.skeleton);
-  for (const Joint& j : img->skeleton.joints)
+  for (const Joint& j : img->skeleton.joints) {
     for (double o : j.offset) img->node_offset.push_back(static_cast<float>(o));
+    img->pose_first.push_back(static_cast<uint32_t>(img->pose_steps.size()));
+    for (size_t k = 0; k < j.channels.size(); ++k)
+      img->pose_steps.push_back({j.first_channel + static_cast<uint32_t>(k), static_cast<uint8_t>(channel_axis(j.channels[k])),
+                                 static_cast<uint8_t>(is_rotation(j.channels[k]))});
+  }
+  img->pose_first.push_back(static_cast<uint32_t>(img->pose_steps.size()));
   img->notes = std::move(src.notes);
   img->total_keys = src.frames.size();
   static std::atomic<uint64_t> next_id{1};

@@ -46,37 +46,33 @@ constexpr uint32_t kAngles = 64;  // rotation channels converted per batch
 
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
                       Transform* out) noexcept {
-  const auto& joints = img.skeleton.joints;
-  const uint32_t column0 = first < last ? joints[first].first_channel : 0;
+  if (first >= last) return;
+  const Image::PoseStep* steps = img.pose_steps.data();
+  const uint32_t* at = img.pose_first.data();
+  const uint32_t column0 = at[first] < at[last] ? steps[at[first]].column : 0;
   float angles[kAngles], sines[kAngles], cosines[kAngles];
   uint32_t node = first;
   while (node < last) {
     // Nodes [node, end) whose rotation channels fit one batch (a node has at most 6 channels).
     uint32_t end = node, count = 0;
-    for (; end < last; ++end) {
-      uint32_t r = 0;
-      for (ChannelType t : joints[end].channels) r += is_rotation(t);
-      if (count + r > kAngles) break;
-      for (size_t k = 0; k < joints[end].channels.size(); ++k)
-        if (is_rotation(joints[end].channels[k])) angles[count++] = values[joints[end].first_channel + k - column0];
-    }
+    for (; end < last && count + (at[end + 1] - at[end]) <= kAngles; ++end)
+      for (uint32_t s = at[end]; s < at[end + 1]; ++s)
+        if (steps[s].rotation) angles[count++] = values[steps[s].column - column0];
     half_sincos_deg(angles, sines, cosines, count);
     uint32_t a = 0;
     for (; node < end; ++node) {
-      const Joint& j = joints[node];
       Transform& t = out[node - first];
       t = Transform{};
       const float* offset = img.node_offset.data() + 3 * size_t(node);
       std::copy(offset, offset + 3, t.translation);
-      for (size_t k = 0; k < j.channels.size(); ++k) {
-        const ChannelType type = j.channels[k];
-        const int axis = channel_axis(type);
-        if (is_rotation(type)) {
-          rotate_by(t.rotation, axis, sines[a], cosines[a]);
+      for (uint32_t s = at[node]; s < at[node + 1]; ++s) {
+        const Image::PoseStep step = steps[s];
+        if (step.rotation) {
+          rotate_by(t.rotation, step.axis, sines[a], cosines[a]);
           ++a;
         } else {
-          const float v = values[j.first_channel + k - column0];
-          t.translation[axis] = reading == PositionReading::add ? offset[axis] + v : v;
+          const float v = values[step.column - column0];
+          t.translation[step.axis] = reading == PositionReading::add ? offset[step.axis] + v : v;
         }
       }
     }
