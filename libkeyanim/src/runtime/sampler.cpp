@@ -187,34 +187,48 @@ Facts batch_facts(const Batch& b) {
   return {b.s, b.first_frame, b.last_frame, b.first_value, b.last_value, b.linear};
 }
 
-// The listed channels at f, out[i] for channels[i].
-template <bool kPopcnt>
-[[gnu::always_inline]] inline void sample_chunks(const Image& img, float f, const uint32_t* channels, uint32_t count,
-                                                 float* out) noexcept {
+// The two passes over chunks of `count` lanes at position f: fill(b, at, view, base, m)
+// gathers lanes [base, base + m) into b, facts(b, base) says where their per-curve facts are,
+// emit(res, base, m) writes the results.
+template <class Fill, class FactsOf, class Emit>
+[[gnu::always_inline]] inline void run_chunks(const Image& img, float f, uint32_t count, Fill fill, FactsOf facts,
+                                              Emit emit) noexcept {
   Batch b;
   alignas(16) float res[kChunk];
   const Position at = position(img, f);
   const BlockView view = block_view(img, at);
   for (uint32_t base = 0; base < count; base += kChunk) {
     const uint32_t m = std::min(kChunk, count - base);
+    fill(b, at, view, base, m);
+    const uint32_t lanes = (m + 3) & ~3u;
+    for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
+    evaluate(img, b, facts(b, base), at, lanes, res);
+    emit(res, base, m);
+  }
+}
+
+// The listed channels at f, out[i] for channels[i].
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void sample_chunks(const Image& img, float f, const uint32_t* channels, uint32_t count,
+                                                 float* out) noexcept {
+  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
     for (uint32_t i = 0; i < m; ++i) {
       const uint32_t c = channels[base + i];
       const uint32_t curve = img.curve_of[c];
       if (curve == kNoCurve) {
         set_fixed(b, i, img.fixed_value[c]);
-      } else {
-        if (curve < img.block_curves)
-          gather<kPopcnt>(view, curve, at.t, b, i);
-        else
-          gather_list(img, curve, at, b, i);
-        copy_facts(img, curve, b, i);
+        continue;
       }
+      if (curve < img.block_curves)
+        gather<kPopcnt>(view, curve, at.t, b, i);
+      else
+        gather_list(img, curve, at, b, i);
+      copy_facts(img, curve, b, i);
     }
-    const uint32_t lanes = (m + 3) & ~3u;
-    for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
-    evaluate(img, b, batch_facts(b), at, lanes, res);
-    std::memcpy(out + base, res, m * sizeof(float));
-  }
+  };
+  auto facts = [](const Batch& b, uint32_t) { return batch_facts(b); };
+  auto emit = [&](const float* res, uint32_t base, uint32_t m) { std::memcpy(out + base, res, m * sizeof(float)); };
+  run_chunks(img, f, count, fill, facts, emit);
 }
 
 // Every curve in order, written to its channel; the fixed channels separately. The per-curve
@@ -222,23 +236,19 @@ template <bool kPopcnt>
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
-  const uint32_t count = static_cast<uint32_t>(img.curves.size());
-  Batch b;
-  alignas(16) float res[kChunk];
-  const Position at = position(img, f);
-  const BlockView view = block_view(img, at);
-  for (uint32_t base = 0; base < count; base += kChunk) {
-    const uint32_t m = std::min(kChunk, count - base);
+  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
     for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, at.t, b, i);
     for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
-    const uint32_t lanes = (m + 3) & ~3u;
-    for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
-    const Facts x{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
-                  img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
-    evaluate(img, b, x, at, lanes, res);
+  };
+  auto facts = [&](const Batch&, uint32_t base) {
+    return Facts{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
+                 img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
+  };
+  auto emit = [&](const float* res, uint32_t base, uint32_t m) {
     for (uint32_t i = 0; i < m; ++i) out[img.curves[base + i].channel] = res[i];
-  }
+  };
+  run_chunks(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
 }
 
 // The popcnt instruction is not part of baseline x86-64: the same code is compiled twice and
