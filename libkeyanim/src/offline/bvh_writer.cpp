@@ -1,5 +1,6 @@
-// BVH writer: one std::string built in place, numbers in std::to_chars' shortest round-trip form
-// (with a faster path that gives the same text), so that reading back gives bit-identical doubles.
+// BVH writer: text built in place in one reused buffer and handed on in chunks (write_bvh
+// collects them into one string), numbers in std::to_chars' shortest round-trip form (with a
+// faster path that gives the same text), so that reading back gives bit-identical doubles.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -7,6 +8,7 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "keyanim/offline/bvh.h"
@@ -87,9 +89,11 @@ inline char* write_number(char* p, char* end, double v) noexcept {
   return std::to_chars(p, end, v).ptr;
 }
 
-class Output {
+// Appends to a caller's buffer, whose first `used` bytes are text: the buffer grows by
+// doubling and is never shrunk, so a streaming writer reuses one allocation.
+class Text {
  public:
-  explicit Output(size_t estimate) { s_.resize(estimate); }
+  Text(std::string& s, size_t& used) : s_(s), n_(used) {}
   // Guarantees room for k more bytes and returns where they go.
   char* room(size_t k) {
     if (s_.size() - n_ < k) s_.resize(std::max(s_.size() * 2, n_ + k));
@@ -108,29 +112,32 @@ class Output {
     char* p = room(kMaxNumber);
     commit(write_number(p, p + kMaxNumber, d));
   }
+  void put_count(uint64_t n) {
+    char* p = room(24);
+    commit(std::to_chars(p, p + 24, n).ptr);
+  }
+  // Indentation stops growing at kMaxIndent: a deep chain would otherwise make the text
+  // quadratic in its depth.
   void indent(size_t depth) {
+    depth = std::min(depth, kMaxIndent);
     char* p = room(depth);
     std::memset(p, '\t', depth);
     commit(p + depth);
   }
-  std::string take() {
-    s_.resize(n_);
-    return std::move(s_);
-  }
 
  private:
-  std::string s_;
-  size_t n_ = 0;
+  std::string& s_;
+  size_t& n_;
 };
 
-}  // namespace
+// About this much text is handed to the sink at a time.
+constexpr size_t kChunk = size_t(1) << 20;
 
-// The hierarchy is written depth-first with children in index order, which is the order the
-// reader stores nodes in. A node whose parent is not an earlier node is written as a ROOT; a node
-// is written as an End Site only if it is flagged so and has neither channels nor children (else
-// as a JOINT), so no value column is ever dropped. Frame columns follow the written order.
-std::string write_bvh(const Motion& motion) {
-  const std::vector<Joint>& joints = motion.skeleton.joints;
+// The hierarchy, depth-first with children in index order, which is the order the reader
+// stores nodes in. A node whose parent is not an earlier node is written as a ROOT; a node is
+// written as an End Site only if it is flagged so and has neither channels nor children (else
+// as a JOINT), so no value column is ever dropped. Returns the nodes in written order.
+std::vector<uint32_t> write_hierarchy(const std::vector<Joint>& joints, Text& out) {
   const size_t node_count = joints.size();
 
   // Children as a compact list per node (CSR), in index order; roots separately.
@@ -152,18 +159,6 @@ std::string write_bvh(const Motion& motion) {
     for (size_t i = 0; i < node_count; ++i)
       if (const int64_t p = parent_of(i); p >= 0) children[fill[size_t(p)]++] = uint32_t(i);
   }
-
-  // Column of each node's first channel, from the channel lists (first_channel may be stale).
-  std::vector<uint32_t> column(node_count + 1, 0);
-  for (size_t i = 0; i < node_count; ++i) column[i + 1] = column[i] + uint32_t(joints[i].channels.size());
-  const uint32_t channel_count = column[node_count];
-
-  size_t frames = motion.frame_count;
-  if (channel_count > 0) frames = std::min(frames, motion.values.size() / channel_count);
-
-  size_t header_estimate = 64;
-  for (const Joint& j : joints) header_estimate += j.name.size() + 160;
-  Output out(header_estimate + frames * channel_count * 12 + frames);
 
   out.put("HIERARCHY\n");
   std::vector<uint32_t> order;  // nodes in written order
@@ -202,8 +197,7 @@ std::string write_bvh(const Motion& motion) {
     if (!end_site) {
       out.indent(depth + 1);
       out.put("CHANNELS ");
-      char* p = out.room(24);
-      out.commit(std::to_chars(p, p + 24, j.channels.size()).ptr);
+      out.put_count(j.channels.size());
       for (ChannelType c : j.channels) {
         out.put(' ');
         out.put(channel_name(c));
@@ -226,38 +220,73 @@ std::string write_bvh(const Motion& motion) {
       }
     }
   }
+  return order;
+}
 
+}  // namespace
+
+BvhWriter::BvhWriter(const Skeleton& skeleton, uint64_t frame_count, double frame_time, Sink sink)
+    : sink_(std::move(sink)), declared_(frame_count) {
+  const std::vector<Joint>& joints = skeleton.joints;
+  size_t header_estimate = 64;
+  for (const Joint& j : joints) header_estimate += j.name.size() + 160;
+  buffer_.resize(std::min(header_estimate, kChunk));
+  Text out(buffer_, used_);
+  const std::vector<uint32_t> order = write_hierarchy(joints, out);
   out.put("MOTION\nFrames: ");
-  {
-    char* p = out.room(24);
-    out.commit(std::to_chars(p, p + 24, frames).ptr);
-  }
+  out.put_count(frame_count);
   out.put("\nFrame Time: ");
-  out.put_number(motion.frame_time);
+  out.put_number(frame_time);
   out.put('\n');
 
-  // Source column of each written column; identity for anything the reader produced.
-  std::vector<uint32_t> source;
-  source.reserve(channel_count);
+  // Column of each node's first channel, from the channel lists (first_channel may be stale),
+  // and the source column of each written column: identity for anything the reader produced.
+  std::vector<uint32_t> column(joints.size() + 1, 0);
+  for (size_t i = 0; i < joints.size(); ++i) column[i + 1] = column[i] + uint32_t(joints[i].channels.size());
+  source_.reserve(column.back());
   for (uint32_t i : order)
-    for (uint32_t c = column[i]; c < column[i + 1]; ++c) source.push_back(c);
-  bool identity = true;
-  for (uint32_t c = 0; c < channel_count; ++c) identity = identity && source[c] == c;
+    for (uint32_t c = column[i]; c < column[i + 1]; ++c) source_.push_back(c);
+  for (uint32_t c = 0; c < source_.size(); ++c) identity_ = identity_ && source_[c] == c;
+  if (used_ >= kChunk) flush();
+}
 
-  const double* values = motion.values.data();
-  for (size_t f = 0; f < frames; ++f) {
-    const double* row = values + f * channel_count;
-    char* p = out.room(size_t(channel_count) * kMaxNumber + 1);
-    char* const limit = p + size_t(channel_count) * kMaxNumber + 1;
-    for (uint32_t c = 0; c < channel_count; ++c) {
-      p = write_number(p, limit, identity ? row[c] : row[source[c]]);
-      *p++ = ' ';
-    }
-    if (channel_count > 0) --p;  // the last separator becomes the line end
-    *p++ = '\n';
-    out.commit(p);
+void BvhWriter::frame(const double* row) {
+  const size_t channels = source_.size();
+  Text out(buffer_, used_);
+  char* p = out.room(channels * kMaxNumber + 1);
+  char* const limit = p + channels * kMaxNumber + 1;
+  for (size_t c = 0; c < channels; ++c) {
+    p = write_number(p, limit, identity_ ? row[c] : row[source_[c]]);
+    *p++ = ' ';
   }
-  return out.take();
+  if (channels > 0) --p;  // the last separator becomes the line end
+  *p++ = '\n';
+  out.commit(p);
+  ++written_;
+  if (used_ >= kChunk) flush();
+}
+
+void BvhWriter::flush() {
+  if (used_ > 0) sink_(std::string_view(buffer_.data(), used_));
+  used_ = 0;
+}
+
+bool BvhWriter::finish() {
+  flush();
+  return written_ == declared_;
+}
+
+std::string write_bvh(const Motion& motion) {
+  size_t channels = 0;
+  for (const Joint& j : motion.skeleton.joints) channels += j.channels.size();
+  size_t frames = motion.frame_count;
+  if (channels > 0) frames = std::min(frames, motion.values.size() / channels);
+  std::string text;
+  text.reserve(motion.skeleton.joints.size() * 100 + frames * channels * 12 + frames + 64);
+  BvhWriter writer(motion.skeleton, frames, motion.frame_time, [&](std::string_view chunk) { text.append(chunk); });
+  for (size_t f = 0; f < frames; ++f) writer.frame(motion.values.data() + f * channels);
+  writer.finish();
+  return text;
 }
 
 }  // namespace keyanim::offline

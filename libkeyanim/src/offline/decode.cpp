@@ -1,4 +1,4 @@
-// Rebuilding a Motion from a clip: the source frames, another frame rate, or in-betweens.
+// Rebuilding frames from a clip: the source frames, another frame rate, or in-betweens.
 //
 // Output frame i lies at source frame position
 //   source rate:   first + i                         i = 0 .. last - first
@@ -10,6 +10,7 @@
 // every 4th frame despite rounding). Positions are computed from i by one multiplication or
 // division, never accumulated.
 #include <cmath>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,8 +19,11 @@
 
 namespace keyanim::offline {
 
-bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error) {
+bool FrameDecoder::start(const Clip& clip, const ResampleOptions& options, std::string& error) {
   error.clear();
+  clip_ = &clip;
+  options_ = options;
+  count_ = 0;
   const uint32_t frames = clip.frame_count();
   if (std::isnan(options.fps) || options.fps < 0.0 || std::isinf(options.fps)) {
     error = "fps must be a finite number > 0 (or 0 for the source rate)";
@@ -33,74 +37,70 @@ bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out
     error = "the clip has no frame time; cannot resample to fps";
     return false;
   }
-  const bool whole = options.first_frame == 0 && options.last_frame == UINT32_MAX;
-  Motion m;
-  m.skeleton = clip.skeleton();
-  m.skeleton.assign_channel_columns();
-  const uint32_t channels = clip.channel_count();
+  const double per = static_cast<double>(options.inbetweens) + 1.0;
+  frame_time_ = options.fps > 0.0 ? 1.0 / options.fps : clip.frame_time() / per;
   if (frames == 0) {
-    if (!whole) {
+    if (options.first_frame != 0 || options.last_frame != UINT32_MAX) {
       error = "the clip has no frames; no frame range can be decoded";
       return false;
     }
-    m.frame_time = options.fps > 0.0 ? 1.0 / options.fps : clip.frame_time() / (options.inbetweens + 1.0);
-    out = std::move(m);
     return true;
   }
-  const uint32_t first = options.first_frame;
-  const uint32_t last = options.last_frame == UINT32_MAX ? frames - 1 : options.last_frame;
-  if (last >= frames) {
-    error = "last_frame " + std::to_string(last) + " is beyond the clip's last frame " + std::to_string(frames - 1);
+  first_ = options.first_frame;
+  last_ = options.last_frame == UINT32_MAX ? frames - 1 : options.last_frame;
+  if (last_ >= frames) {
+    error = "last_frame " + std::to_string(last_) + " is beyond the clip's last frame " + std::to_string(frames - 1);
     return false;
   }
-  if (first > last) {
-    error = "first_frame " + std::to_string(first) + " is after last_frame " + std::to_string(last);
+  if (first_ > last_) {
+    error = "first_frame " + std::to_string(first_) + " is after last_frame " + std::to_string(last_);
     return false;
   }
-
-  const uint64_t span = last - first;
-  uint64_t count = 0;
-  double frame_time = clip.frame_time();
+  const uint64_t span = last_ - first_;
   if (options.fps > 0.0) {
-    const double duration = static_cast<double>(span) * clip.frame_time();
-    const double n = std::floor(duration * options.fps + 1e-6);
-    if (!(n < 4294967295.0)) {
-      error = "too many output frames";
-      return false;
-    }
-    count = static_cast<uint64_t>(n) + 1;
-    frame_time = 1.0 / options.fps;
+    // Saturates rather than overflows: the caller compares the count with its own limits.
+    const double n = std::floor(static_cast<double>(span) * clip.frame_time() * options.fps + 1e-6);
+    count_ = n < 1.8e19 ? static_cast<uint64_t>(n) + 1 : UINT64_MAX;
   } else {
-    const uint64_t per = uint64_t(options.inbetweens) + 1;
-    count = span * per + 1;
-    frame_time = clip.frame_time() / static_cast<double>(per);
+    count_ = span * (uint64_t(options.inbetweens) + 1) + 1;  // < 2^64: both factors < 2^32
   }
+  pose_.assign(clip.channel_count(), 0.0f);
+  if (cursor_.prepare(clip) != Status::ok) throw std::bad_alloc();
+  return true;
+}
+
+void FrameDecoder::frame(uint64_t i, std::span<double> row) {
+  const uint64_t span = last_ - first_;
+  double position;
+  if (options_.fps > 0.0 && span == 0)
+    position = first_;  // a single frame, whatever the frame time (it may be 0)
+  else if (options_.fps > 0.0)
+    position = first_ + (static_cast<double>(i) / options_.fps) / clip_->frame_time();
+  else if (options_.inbetweens > 0)
+    position = first_ + static_cast<double>(i) / (static_cast<double>(options_.inbetweens) + 1.0);
+  else
+    position = static_cast<double>(first_ + i);
+  if (position > last_) position = last_;  // the 1e-6 slack may overshoot by a hair
+  clip_->sample(position, pose_, &cursor_);
+  for (size_t c = 0; c < pose_.size() && c < row.size(); ++c) row[c] = static_cast<double>(pose_[c]);
+}
+
+bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error) {
+  FrameDecoder decoder;
+  if (!decoder.start(clip, options, error)) return false;
+  const uint64_t count = decoder.frame_count();
+  const uint32_t channels = clip.channel_count();
   if (count > UINT32_MAX || (channels > 0 && count > (uint64_t(1) << 40) / channels)) {
     error = "too many output frames (" + std::to_string(count) + ")";
     return false;
   }
+  Motion m;
+  m.skeleton = clip.skeleton();
+  m.skeleton.assign_channel_columns();
   m.frame_count = static_cast<uint32_t>(count);
-  m.frame_time = frame_time;
+  m.frame_time = decoder.frame_time();
   m.values.resize(static_cast<size_t>(count) * channels);
-  std::vector<float> pose(channels);
-  Cursor cursor;
-  if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
-  const double per = static_cast<double>(options.inbetweens) + 1.0;
-  for (uint64_t i = 0; i < count; ++i) {
-    double position;
-    if (options.fps > 0.0 && span == 0)
-      position = first;  // a single frame, whatever the frame time (it may be 0)
-    else if (options.fps > 0.0)
-      position = first + (static_cast<double>(i) / options.fps) / clip.frame_time();
-    else if (options.inbetweens > 0)
-      position = first + static_cast<double>(i) / per;
-    else
-      position = static_cast<double>(first + i);
-    if (position > last) position = last;  // the 1e-6 slack may overshoot by a hair
-    clip.sample(position, pose, &cursor);
-    double* row = m.values.data() + i * channels;
-    for (uint32_t c = 0; c < channels; ++c) row[c] = static_cast<double>(pose[c]);
-  }
+  for (uint64_t i = 0; i < count; ++i) decoder.frame(i, {m.values.data() + i * channels, channels});
   out = std::move(m);
   return true;
 }

@@ -1,7 +1,9 @@
 // BVH reading and writing. The reader accepts the format as real files use it and reports
 // damage as file:line:column; the writer prints the shortest text that reads back bit-exactly.
 #pragma once
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,12 +47,42 @@ bool read_bvh(std::string_view text, const std::string& file_name, Motion& out, 
 bool read_bvh_file(const std::string& path, Motion& out, BvhError& err,
                    std::vector<std::string>* warnings = nullptr, const BvhReadOptions& options = {});
 
-// BVH text with LF line endings and tab indentation; numbers in std::to_chars' shortest form,
-// which reads back to the same double, so read(write(m)) == m bit for bit. Nodes are written
-// depth-first (children in index order: the reader's order) and the frame columns follow. A node
-// whose parent is not an earlier node is written as a ROOT; an End Site is written as "End Site"
-// (plus " name" if it has one) only when it has no channels and no children, else as a JOINT.
+// BVH text with LF line endings and tab indentation (at most kMaxIndent tabs, so that the text
+// stays linear in the node count however deep the hierarchy: readers do not need indentation);
+// numbers in std::to_chars' shortest form, which reads back to the same double, so
+// read(write(m)) == m bit for bit. Nodes are written depth-first (children in index order: the
+// reader's order) and the frame columns follow. A node whose parent is not an earlier node is
+// written as a ROOT; an End Site is written as "End Site" (plus " name" if it has one) only when
+// it has no channels and no children, else as a JOINT.
 // Writes min(frame_count, values.size() / channel_count) frames.
 std::string write_bvh(const Motion& motion);
+
+inline constexpr size_t kMaxIndent = 32;
+
+// The same text written piece by piece, for outputs too large to hold: the hierarchy and the
+// MOTION header first, then one frame at a time. Text reaches `sink` in chunks of about 1 MiB
+// (the last one at finish()), so memory does not grow with the number of frames.
+class BvhWriter {
+ public:
+  using Sink = std::function<void(std::string_view)>;
+  // Writes the hierarchy and "Frames: frame_count". The skeleton must outlive the writer.
+  BvhWriter(const Skeleton& skeleton, uint64_t frame_count, double frame_time, Sink sink);
+  BvhWriter(const BvhWriter&) = delete;
+  BvhWriter& operator=(const BvhWriter&) = delete;
+  // One frame: the skeleton's channel_count() values in column order (as Motion::frame()).
+  void frame(const double* values);
+  // Hands what is left to the sink. False if the frames given differ from the declared count
+  // (the text is then not valid BVH).
+  bool finish();
+
+ private:
+  void flush();
+  Sink sink_;
+  std::string buffer_;
+  size_t used_ = 0;
+  std::vector<uint32_t> source_;  // source column of each written column
+  bool identity_ = true;
+  uint64_t declared_ = 0, written_ = 0;
+};
 
 }  // namespace keyanim::offline

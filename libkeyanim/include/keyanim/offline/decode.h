@@ -2,7 +2,9 @@
 // in-between frames per source frame interval (motion tweening: values come from the curves).
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "keyanim/clip.h"
 #include "keyanim/offline/motion.h"
@@ -23,9 +25,35 @@ struct ResampleOptions {
 // with D = (last - first) frame_time seconds: frames every 1/fps s from the range's start up
 // to its end, the end included when it lands on an output frame (within 1e-6 of one).
 // Values are the clip's float samples as doubles; frame_time becomes frame_time / (N + 1) or
-// 1 / fps. A clip without frames decodes to an empty motion.
-// Fails (returns false) only for options that make no sense (fps < 0 or not finite, both fps
-// and inbetweens, an empty or reversed range, last_frame beyond the clip); `error` says why.
+// 1 / fps. A clip without frames decodes to no frames.
+//
+// FrameDecoder produces those frames one at a time, so that a caller can stream them (e.g. to
+// a BvhWriter) in memory independent of their number, and can see how many there will be
+// before producing any.
+class FrameDecoder {
+ public:
+  // Checks `options` against `clip` (which must outlive the decoder). Fails (returns false,
+  // `error` says why) only for options that make no sense: fps < 0 or not finite, both fps and
+  // inbetweens, fps for a clip without frame time, an empty or reversed range, last_frame
+  // beyond the clip. Any number of output frames is accepted here.
+  bool start(const Clip& clip, const ResampleOptions& options, std::string& error);
+  uint64_t frame_count() const noexcept { return count_; }
+  double frame_time() const noexcept { return frame_time_; }
+  // Output frame i < frame_count(): clip.channel_count() values. Fastest in increasing i.
+  void frame(uint64_t i, std::span<double> row);
+
+ private:
+  const Clip* clip_ = nullptr;
+  ResampleOptions options_;
+  uint32_t first_ = 0, last_ = 0;
+  uint64_t count_ = 0;
+  double frame_time_ = 0.0;
+  std::vector<float> pose_;
+  Cursor cursor_;
+};
+
+// All frames of a FrameDecoder as one Motion. Fails as FrameDecoder::start, and also when the
+// result would have 2^32 frames or more, or more than 2^40 values.
 bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error);
 
 }  // namespace keyanim::offline
