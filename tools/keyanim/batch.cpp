@@ -8,7 +8,10 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <system_error>
 #include <thread>
+
+#include "escape.h"
 
 namespace keyanim::cli {
 
@@ -36,8 +39,11 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
 }
 
 unsigned thread_count(const Args& args) {
+  // More threads than cores would not go faster, only take more memory (and a huge -j, if
+  // obeyed, could exhaust the machine's threads).
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const uint32_t j = args.get_uint("-j", 0);
-  return j ? j : std::max(1u, std::thread::hardware_concurrency());
+  return j ? std::min<unsigned>(j, cores) : cores;
 }
 
 int run_batch(size_t count, unsigned threads, const Globals& g, const std::function<void(size_t)>& job,
@@ -64,21 +70,26 @@ int run_batch(size_t count, unsigned threads, const Globals& g, const std::funct
         codes[i] = f.code;
         message = f.message;
       } catch (const std::exception& e) {
-        codes[i] = kBadInput;
-        message = names[i] + ": " + e.what();
+        const Failure f = failure_of(e);
+        codes[i] = f.code;
+        message = names[i] + ": " + f.message;
       }
       ++done;
       std::lock_guard<std::mutex> lock(out_mutex);
       if (!message.empty()) {
         if (bar) std::fprintf(stderr, "\r%*s\r", 50, "");
-        std::cerr << "keyanim: " << message << "\n";
+        std::cerr << "keyanim: " << printable(message) << "\n";
       }
       progress();
     }
   };
   std::vector<std::thread> pool;
   const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(count)));
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(worker);
+  try {
+    for (unsigned t = 1; t < n; ++t) pool.emplace_back(worker);
+  } catch (const std::system_error&) {
+    // Out of threads: the ones started (and this one) do all the work.
+  }
   worker();
   for (std::thread& t : pool) t.join();
   size_t failed = 0;

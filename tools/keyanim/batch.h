@@ -18,7 +18,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
 int run_batch(size_t count, unsigned threads, const Globals& g, const std::function<void(size_t)>& job,
               const std::vector<std::string>& names);
 
-// -j N: 0 means one thread per core.
+// -j N: 0 means one thread per core; more than the cores is clamped to them.
 unsigned thread_count(const Args& args);
 
 }  // namespace keyanim::cli

@@ -1,72 +1,32 @@
 #include "cli.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <atomic>
 #include <cerrno>
-#include <csignal>
-#include <cmath>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
+#include <new>
+#include <system_error>
 
+#include "escape.h"
 #include "keyanim/offline/bvh.h"
-#include "keyanim/offline/decode.h"
 
 namespace keyanim::cli {
-namespace {
 
-// Temporary outputs being written, so that an interrupt removes them (no partial files). Slots
-// are fixed arrays: the signal handler may only touch memory that is already there.
-constexpr int kMaxTemps = 256;
-char g_temp_names[kMaxTemps][4096];
-std::atomic<bool> g_temp_used[kMaxTemps];
-
-int register_temp(const std::string& name) {
-  if (name.size() >= sizeof g_temp_names[0]) return -1;
-  for (int i = 0; i < kMaxTemps; ++i) {
-    bool expected = false;
-    if (g_temp_used[i].load() || !g_temp_used[i].compare_exchange_strong(expected, true)) continue;
-    std::memcpy(g_temp_names[i], name.c_str(), name.size() + 1);
-    return i;
-  }
-  return -1;
-}
-
-void unregister_temp(int slot) {
-  if (slot >= 0) g_temp_used[slot].store(false);
-}
-
-extern "C" void remove_temps_and_die(int sig) {
-  for (int i = 0; i < kMaxTemps; ++i)
-    if (g_temp_used[i].load()) ::unlink(g_temp_names[i]);
-  std::signal(sig, SIG_DFL);
-  std::raise(sig);
-}
-
-// Writes everything, retrying short writes; 0 or the errno that stopped it.
-int write_all(int fd, const std::string& data) {
-  size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return n < 0 ? errno : EIO;
-    done += size_t(n);
-  }
-  return 0;
-}
-
-}  // namespace
-
-void install_interrupt_cleanup() {
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) std::signal(sig, remove_temps_and_die);
-}
+const char* const kExitCodeTable =
+    "exit codes:\n"
+    "  0  success\n"
+    "  1  usage: unknown option, bad or out-of-range value, conflicting options (e.g. --json\n"
+    "     with -o -), a frame, joint or channel the input does not have\n"
+    "  2  input unreadable or malformed, or without what the command needs (no frames)\n"
+    "  3  input uses an unsupported format version or feature\n"
+    "  4  output cannot be written: exists (without -f), is an input, would also be another\n"
+    "     input's output, is a directory, its directory is missing or read-only, disk full\n"
+    "  5  a requested check failed (verify --max-error)\n"
+    "  6  a limit was reached: input over --max-input, decode over --max-values, a .kanim over\n"
+    "     the loader's limits, out of memory\n"
+    "  7  internal error: a bug in keyanim (please report it)\n";
 
 void fail(int code, const std::string& message) { throw Failure{code, message}; }
 
@@ -134,22 +94,39 @@ uint32_t Args::get_uint(const std::string& name, uint32_t fallback) const {
   return v ? parse_uint(name, *v) : fallback;
 }
 
-std::vector<uint8_t> read_input(const std::string& path) {
-  if (path == "-") {
-    std::vector<uint8_t> bytes;
-    char buf[1 << 16];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, stdin)) > 0) bytes.insert(bytes.end(), buf, buf + n);
-    if (std::ferror(stdin)) fail(kBadInput, "-: cannot read standard input");
-    return bytes;
+uint64_t parse_size(const std::string& option, const std::string& text) {
+  uint64_t v = 0;
+  const char* end = text.data() + text.size();
+  auto [p, ec] = std::from_chars(text.data(), end, v);
+  int shift = 0;
+  if (p + 1 == end) {
+    const char* units = "KMGT";
+    for (int k = 0; k < 4; ++k)
+      if (*p == units[k] || *p == units[k] + ('a' - 'A')) shift = 10 * (k + 1), ++p;
   }
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(kBadInput, path + ": is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(kBadInput, path + ": cannot open: " + std::strerror(errno));
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail(kBadInput, path + ": read error");
-  return bytes;
+  if (ec != std::errc() || p != end || v == 0 || (shift && v > (UINT64_MAX >> shift)))
+    fail(kUsage, option + " expects a size such as 1000, 64K, 512M or 2G (at least 1), got '" + text + "'");
+  return v << shift;
+}
+
+void check_values(uint64_t frames, uint64_t channels, const std::string& what, const Globals& g) {
+  const uint64_t per_frame = std::max<uint64_t>(channels, 1);
+  if (frames <= g.limits.max_values / per_frame) return;
+  const long double values = static_cast<long double>(frames) * per_frame;
+  char text[160];
+  std::snprintf(text, sizeof text, "%.4Lg values (%llu frames x %llu channels)", values,
+                static_cast<unsigned long long>(frames), static_cast<unsigned long long>(channels));
+  fail(kLimit, what + " would make " + text + ", over the limit of " + std::to_string(g.limits.max_values) +
+                   " (raise it with --max-values N)");
+}
+
+Failure failure_of(const std::exception& e) {
+  if (dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e))
+    return {kLimit, "out of memory"};
+  if (const auto* s = dynamic_cast<const std::system_error*>(&e);
+      s && (s->code() == std::errc::resource_unavailable_try_again || s->code() == std::errc::not_enough_memory))
+    return {kLimit, std::string("out of resources: ") + e.what()};
+  return {kInternal, std::string("internal error (a bug in keyanim; please report it): ") + e.what()};
 }
 
 bool looks_like_kanim(const std::vector<uint8_t>& b) {
@@ -164,11 +141,9 @@ offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   if (!offline::read_bvh(text, path, m, err, &warnings)) fail(kBadInput, err.to_string());
   if (g.verbosity > 0)
-    for (const std::string& w : warnings) std::cerr << "keyanim: warning: " << w << "\n";
+    for (const std::string& w : warnings) std::cerr << "keyanim: warning: " << printable(w) << "\n";
   return m;
 }
-
-offline::Motion load_bvh(const std::string& path, const Globals& g) { return load_bvh_bytes(path, read_input(path), g); }
 
 Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes) {
   Clip clip;
@@ -178,78 +153,17 @@ Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes) {
     char where[64];
     std::snprintf(where, sizeof where, "offset %llu (0x%llX)", static_cast<unsigned long long>(info.byte_offset),
                   static_cast<unsigned long long>(info.byte_offset));
-    fail(s == Status::unsupported_version ? kUnsupported : kBadInput,
-         path + ": section " + (info.section.empty() ? "?" : info.section) + ", " + where + ": " +
-             status_string(s) + ": " + info.detail);
+    const int code = s == Status::unsupported_version ? kUnsupported : s == Status::limit_exceeded ? kLimit : kBadInput;
+    fail(code, path + ": section " + (info.section.empty() ? "?" : info.section) + ", " + where + ": " +
+                   status_string(s) + ": " + info.detail);
   }
   return clip;
-}
-
-offline::Motion load_motion(const std::string& path, const Globals& g) {
-  const std::vector<uint8_t> bytes = read_input(path);
-  if (!looks_like_kanim(bytes)) return load_bvh_bytes(path, bytes, g);
-  const Clip clip = load_kanim(path, bytes);
-  offline::Motion m;
-  std::string error;
-  if (!offline::decode_motion(clip, {}, m, error)) fail(kBadInput, path + ": " + error);
-  return m;
 }
 
 std::string swap_extension(const std::string& path, const std::string& ext) {
   std::filesystem::path p(path);
   p.replace_extension(ext);
   return p.string();
-}
-
-void write_output(const std::string& path, const std::string& data, bool binary, const Globals& g) {
-  if (path == "-") {
-    if (binary && isatty(STDOUT_FILENO) && !g.force)
-      fail(kOutputFailed, "refusing to write binary data to a terminal (use -o FILE, a pipe, or -f)");
-    if (std::fwrite(data.data(), 1, data.size(), stdout) != data.size() || std::fflush(stdout) != 0)
-      fail(kOutputFailed, "-: cannot write standard output: " + std::string(std::strerror(errno)));
-    return;
-  }
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(path, ec) && !g.force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
-  if (fs::is_directory(path, ec)) fail(kOutputFailed, path + ": is a directory");
-  // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
-  if (const auto st = fs::status(path, ec); fs::exists(st) && !fs::is_regular_file(st)) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
-    int err = write_all(fd, data);
-    if (::close(fd) != 0 && err == 0) err = errno;
-    if (err != 0) fail(kOutputFailed, path + ": cannot write: " + std::strerror(err));
-    return;
-  }
-  // A temporary file beside the target, renamed over it only once complete.
-  fs::path target(path);
-  std::string tmpl = (target.has_parent_path() ? target.parent_path() / "" : fs::path()).string() + "." +
-                     target.filename().string() + ".tmp.XXXXXX";
-  std::vector<char> name(tmpl.begin(), tmpl.end());
-  name.push_back('\0');
-  const int fd = mkstemp(name.data());
-  if (fd < 0) fail(kOutputFailed, path + ": cannot create a file in its directory: " + std::strerror(errno));
-  const std::string tmp(name.data());
-  const int slot = register_temp(tmp);
-  int err = write_all(fd, data);  // first errno seen
-  if (err == 0 && ::fsync(fd) != 0) err = errno;
-  if (::close(fd) != 0 && err == 0) err = errno;
-  if (err == 0) {  // mkstemp makes 0600; give the file the usual permissions
-    const mode_t mask = ::umask(0);
-    ::umask(mask);
-    ::chmod(tmp.c_str(), 0666 & ~mask);
-    // Without --force the rename itself refuses to replace a file that appeared meanwhile.
-    const int r = g.force ? std::rename(tmp.c_str(), path.c_str())
-                          : ::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, path.c_str(), RENAME_NOREPLACE);
-    if (r != 0) err = errno;
-  }
-  if (err != 0) std::remove(tmp.c_str());
-  unregister_temp(slot);
-  if (err != 0) {
-    if (err == EEXIST) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
-    fail(kOutputFailed, path + ": cannot write: " + std::strerror(err));
-  }
 }
 
 }  // namespace keyanim::cli

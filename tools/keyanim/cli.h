@@ -1,7 +1,8 @@
-// Shared plumbing of the keyanim subcommands: option parsing, exit codes, loading inputs and
-// writing outputs safely (temporary file + rename, never clobbering without --force).
+// Shared plumbing of the keyanim subcommands: exit codes, limits, option parsing and turning
+// input bytes into motions and clips. (Opening inputs and writing outputs safely: io.h.)
 #pragma once
 #include <cstdint>
+#include <exception>
 #include <map>
 #include <optional>
 #include <set>
@@ -13,29 +14,42 @@
 
 namespace keyanim::cli {
 
-// Exit codes: documented in --help and the README; scripts depend on them.
+// Exit codes: one per kind of error, documented by kExitCodeTable (--help) and the README;
+// scripts depend on them.
 enum Exit : int {
   kOk = 0,
-  kUsage = 1,        // bad option, missing argument
-  kBadInput = 2,     // input unreadable or malformed
-  kUnsupported = 3,  // valid input using an unsupported version or feature
-  kOutputFailed = 4, // output cannot be written (exists without -f, I/O error, terminal)
-  kCheckFailed = 5,  // a requested check failed
+  kUsage = 1,         // bad option or value, conflicting options, a frame or joint the input lacks
+  kBadInput = 2,      // input unreadable or malformed, or without what the command needs
+  kUnsupported = 3,   // valid input using an unsupported version or feature
+  kOutputFailed = 4,  // output cannot be written (exists without -f, is an input, collides, I/O)
+  kCheckFailed = 5,   // a requested check failed
+  kLimit = 6,         // a limit was reached: --max-input, --max-values, the loader's, memory
+  kInternal = 7,      // a bug in keyanim
 };
+// The table as printed by --help (the README holds the same lines; a test compares them).
+extern const char* const kExitCodeTable;
 
-// A failure carrying its exit code; thrown inside commands, caught once in main().
+// A failure carrying its exit code; thrown inside commands, caught once in main() (or per
+// input by a batch).
 struct Failure {
   int code;
   std::string message;
 };
 [[noreturn]] void fail(int code, const std::string& message);
+// The exit code and message for an exception that is not a Failure: out of memory (or of
+// threads) is kLimit, anything else a bug (kInternal).
+Failure failure_of(const std::exception& e);
 
-// On SIGINT/SIGTERM/SIGHUP/SIGPIPE: remove the temporary outputs being written, then die.
-void install_interrupt_cleanup();
+// What keyanim takes from untrusted input at most (README, "Untrusted input").
+struct Limits {
+  uint64_t max_input_bytes = uint64_t(1) << 30;  // --max-input: bytes of one input file
+  uint64_t max_values = uint64_t(1) << 28;       // --max-values: frames x channels made by a decode
+};
 
 struct Globals {
   int verbosity = 1;   // 0 with -q, 2+ with -v
   bool force = false;  // -f/--force
+  Limits limits;
 };
 
 // Parsed command line of one subcommand. Options are declared up front so that a typo is a
@@ -59,22 +73,19 @@ class Args {
 
 double parse_double(const std::string& option, const std::string& text);
 uint32_t parse_uint(const std::string& option, const std::string& text);
+// "1000", "64K", "512M", "2G", "1T" (powers of 1024); at least 1.
+uint64_t parse_size(const std::string& option, const std::string& text);
 
-// Whole file ("-" = standard input). Fails with kBadInput.
-std::vector<uint8_t> read_input(const std::string& path);
+// Fails with kLimit unless `frames` frames of `channels` values (at least one a frame: each is
+// a line of text) fit in --max-values. `what` names the request in the message.
+void check_values(uint64_t frames, uint64_t channels, const std::string& what, const Globals& g);
+
 bool looks_like_kanim(const std::vector<uint8_t>& bytes);
-
 // BVH text -> motion, or exit 2 naming file:line:column. Warnings go to stderr unless quiet.
-offline::Motion load_bvh(const std::string& path, const Globals& g);
 offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);
-// .kanim bytes -> clip, or exit 2 (3 for an unsupported version) naming section and offset.
+// .kanim bytes -> clip, or exit 2 (3 for an unsupported version, 6 over the loader's limits)
+// naming section and offset.
 Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes);
-// Either kind, by signature: a BVH becomes a motion; a .kanim is decoded at its source rate.
-offline::Motion load_motion(const std::string& path, const Globals& g);
-
-// Writes `data` to `path` atomically ("-" = standard output). Refuses to replace an existing
-// file without --force and to write binary data to a terminal without --force.
-void write_output(const std::string& path, const std::string& data, bool binary, const Globals& g);
 
 // "walk.bvh" + ".kanim" -> "walk.kanim"
 std::string swap_extension(const std::string& path, const std::string& ext);

@@ -2,6 +2,8 @@
 #include <iostream>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/decode.h"
 
@@ -14,7 +16,9 @@ const char* const kDecodeHelp =
     "  --fps F               resample at F frames per second (F > 0; default: the source rate).\n"
     "                        In-between frames come from the curves: motion tweening.\n"
     "  --inbetweens N        N extra frames in every source frame interval (default 0)\n"
-    "  --frames A:B          source frames A to B inclusive (default: all; A <= B < frame count)\n";
+    "  --frames A:B          source frames A to B inclusive (default: all; A <= B < frame count)\n"
+    "The BVH is written as it is decoded (memory does not grow with its length); a request for\n"
+    "more than --max-values values (frames x channels) is refused before any is made (exit 6).\n";
 
 int cmd_decode(const Argv& argv, Globals& g) {
   const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames"}, {});
@@ -35,15 +39,28 @@ int cmd_decode(const Argv& argv, Globals& g) {
     opt.last_frame = parse_uint("--frames", r->substr(colon + 1));
   }
 
-  const Clip clip = load_kanim(in, read_input(in));
+  Input input(in, g);
+  Output output(out, false, g, ids_of({&input}));
+  const Clip clip = load_kanim(in, input.read(Kind::kanim));
   if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())
     fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
-  offline::Motion m;
+  offline::FrameDecoder decoder;
   std::string error;
-  if (!offline::decode_motion(clip, opt, m, error)) fail(kUsage, error);
-  write_output(out, offline::write_bvh(m), false, g);
+  if (!decoder.start(clip, opt, error)) fail(kUsage, error);
+  check_values(decoder.frame_count(), clip.channel_count(), "decoding " + in, g);
+
+  // Frame by frame from the clip to the output: memory does not grow with the frame count.
+  offline::BvhWriter writer(clip.skeleton(), decoder.frame_count(), decoder.frame_time(),
+                            [&](std::string_view text) { output.write(text); });
+  std::vector<double> row(clip.channel_count());
+  for (uint64_t i = 0; i < decoder.frame_count(); ++i) {
+    decoder.frame(i, row);
+    writer.frame(row.data());
+  }
+  writer.finish();
+  output.commit();
   if (g.verbosity > 0 && out != "-")
-    std::cerr << in << " -> " << out << ": " << m.frame_count << " frames at " << m.frame_time << " s\n";
+    std::cerr << printable(in + " -> " + out) << ": " << decoder.frame_count() << " frames at " << decoder.frame_time() << " s\n";
   return kOk;
 }
 

@@ -2,11 +2,14 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "commands.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "batch.h"
+#include "escape.h"
+#include "io.h"
 #include "report.h"
 #include "settings.h"
 
@@ -19,18 +22,30 @@ const char* const kEncodeHelp =
     "  -o, --output FILE     output (default: IN with .kanim; '-' = standard output).\n"
     "                        IN may be a directory: every .bvh below it is encoded to the same\n"
     "                        relative path below -o OUTDIR, in parallel; bad files are reported\n"
-    "                        and skipped, and the exit code is then non-zero.\n"
-    "  -j N                  threads (default: one per core): a file's channels, or a\n"
-    "                        directory's files\n"
-    "  --json                one JSON object on standard output\n";
+    "                        and skipped, and the exit code is then non-zero. Outputs that\n"
+    "                        would collide (m.bvh and m.BVH), exist (without -f) or are inputs\n"
+    "                        stop the run before any file is encoded.\n"
+    "  -j N                  threads (default and most: one per core): a file's channels, or\n"
+    "                        a directory's files\n"
+    "  --json                one JSON object on standard output (not with -o -); names that\n"
+    "                        are not UTF-8 keep their bytes as \\udcHH escapes\n";
 
 namespace {
 
-// Encodes one file; returns the JSON summary (also used for the human line).
-nlohmann::json encode_one(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
-                          const Globals& g) {
-  const std::vector<uint8_t> bvh_bytes = read_input(in);
+struct Encoded {
+  nlohmann::json summary;  // also what the human line says
+  std::string warning;     // --error exceeded in a key mode that does not apply it
+};
+
+// Encodes one file. Every check that needs no work comes first (input, output, options against
+// the input); the output is written only when everything else has succeeded.
+Encoded encode_one(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
+                   bool error_given, const Globals& g) {
+  Input input(in, g);
+  Output output(out, true, g, ids_of({&input}));
+  const std::vector<uint8_t> bvh_bytes = input.read(Kind::bvh);
   const offline::Motion motion = load_bvh_bytes(in, bvh_bytes, g);
+  check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
   offline::EncodeResult result;
   std::string error;
@@ -38,9 +53,9 @@ nlohmann::json encode_one(const std::string& in, const std::string& out, const o
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level);
   if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  write_output(out, std::string(bytes.begin(), bytes.end()), true, g);
   const double raw = 4.0 * motion.frame_count * motion.channel_count();
-  return {
+  Encoded e;
+  e.summary = {
       {"input", in},
       {"output", out},
       {"frames", motion.frame_count},
@@ -50,18 +65,70 @@ nlohmann::json encode_one(const std::string& in, const std::string& out, const o
       {"bvh_bytes", bvh_bytes.size()},
       {"raw_f32_bytes", static_cast<uint64_t>(raw)},
       {"kanim_bytes", bytes.size()},
-      {"ratio_raw_f32", bytes.empty() ? 0.0 : raw / double(bytes.size())},
-      {"tolerance", result.tolerance_units},
+      {"ratio_raw_f32", raw / double(bytes.size())},
       {"error", error_json(motion.skeleton, result.error)},
       {"encode_ms", encode_ms},
   };
+  // Only error mode applies the tolerance; the other modes say whether --error held.
+  if (settings.key_mode == offline::KeyMode::error) {
+    e.summary["tolerance"] = result.tolerance_units;
+  } else {
+    e.summary["error_limit"] = result.tolerance_units;
+    e.summary["error_limit_met"] = result.error.max_error <= result.tolerance_units;
+  }
+  if (error_given) e.warning = tolerance_warning(settings, result.tolerance_units, result.error.max_error);
+  output.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  output.commit();
+  return e;
 }
 
-void print_line(const nlohmann::json& j) {
-  std::cerr << j["input"].get<std::string>() << " -> " << j["output"].get<std::string>() << ": "
-            << j["kanim_bytes"] << " bytes, " << j["ratio_raw_f32"].get<double>() << "x raw float32, " << j["keys"]
-            << " keys; error max " << j["error"]["max"].get<double>() << " (" << j["error"]["worst_joint"].get<std::string>()
-            << ", frame " << j["error"]["worst_frame"] << "), tolerance " << j["tolerance"].get<double>() << "\n";
+std::string human_line(const nlohmann::json& j) {
+  std::ostringstream line;
+  line << j["input"].get<std::string>() << " -> " << j["output"].get<std::string>() << ": " << j["kanim_bytes"]
+       << " bytes, " << j["ratio_raw_f32"].get<double>() << "x raw float32, " << j["keys"] << " keys; error max "
+       << j["error"]["max"].get<double>() << " (" << j["error"]["worst_joint"].get<std::string>() << ", frame "
+       << j["error"]["worst_frame"] << ")";
+  if (j.contains("tolerance")) line << ", tolerance " << j["tolerance"].get<double>();
+  return printable(line.str());
+}
+
+void print_warning(const Encoded& e, const Globals& g) {
+  if (!e.warning.empty() && g.verbosity > 0)
+    std::cerr << "keyanim: warning: " << printable(e.summary["input"].get<std::string>() + ": " + e.warning) << "\n";
+}
+
+// Directory: every .bvh below IN goes to the same relative path below OUT, as .kanim. All the
+// outputs are checked before the first file is encoded.
+int encode_directory(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
+                     const Args& args, bool json, const Globals& g) {
+  if (out.empty()) fail(kUsage, "encoding a directory needs -o OUTDIR");
+  if (out == "-") fail(kUsage, "encoding a directory cannot write to standard output");
+  const std::vector<std::string> files = expand_inputs({in});
+  if (files.empty()) fail(kBadInput, in + ": no .bvh files found");
+  std::vector<std::string> targets;
+  for (const std::string& f : files)
+    targets.push_back(swap_extension((std::filesystem::path(out) / std::filesystem::relative(f, in)).string(), ".kanim"));
+  check_outputs(files, targets, g);
+  std::vector<Encoded> results(files.size());
+  Globals quiet = g;
+  quiet.verbosity = std::min(g.verbosity, 1);
+  const bool error_given = args.has("--error");
+  const int code = run_batch(files.size(), thread_count(args), g, [&](size_t i) {
+    const std::filesystem::path dir = std::filesystem::path(targets[i]).parent_path();
+    std::error_code mk;
+    std::filesystem::create_directories(dir, mk);
+    if (mk) fail(kOutputFailed, dir.string() + ": cannot create: " + mk.message());
+    results[i] = encode_one(files[i], targets[i], settings, error_given, quiet);
+  }, files);
+  nlohmann::json all = nlohmann::json::array();
+  for (const Encoded& r : results) {
+    if (r.summary.is_null()) continue;
+    all.push_back(r.summary);
+    print_warning(r, g);
+    if (!json && g.verbosity > 1) std::cerr << human_line(r.summary) << "\n";
+  }
+  if (json) std::cout << json_text({{"files", all}, {"failed", files.size() - all.size()}}) << "\n";
+  return code;
 }
 
 }  // namespace
@@ -77,41 +144,15 @@ int cmd_encode(const Argv& argv, Globals& g) {
   const bool json = args.has("--json");
 
   std::error_code ec;
-  if (in == "-" || !std::filesystem::is_directory(in, ec)) {
-    if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".kanim");
-    settings.threads = thread_count(args);  // one file: its channels in parallel
-    const nlohmann::json j = encode_one(in, out, settings, g);
-    if (json) std::cout << j.dump() << "\n";
-    else if (g.verbosity > 0) print_line(j);
-    return kOk;
-  }
-
-  // Directory: every .bvh below IN goes to the same relative path below OUT, as .kanim.
-  if (out.empty()) fail(kUsage, "encoding a directory needs -o OUTDIR");
-  if (out == "-") fail(kUsage, "encoding a directory cannot write to standard output");
-  const std::vector<std::string> files = expand_inputs({in});
-  std::vector<nlohmann::json> results(files.size());
-  Globals quiet = g;
-  quiet.verbosity = std::min(g.verbosity, 1);
-  const int code = run_batch(files.size(), thread_count(args), g, [&](size_t i) {
-    const std::filesystem::path rel = std::filesystem::relative(files[i], in);
-    const std::filesystem::path target = std::filesystem::path(out) / rel;
-    std::error_code mk;
-    std::filesystem::create_directories(target.parent_path(), mk);
-    if (mk) fail(kOutputFailed, target.parent_path().string() + ": cannot create: " + mk.message());
-    results[i] = encode_one(files[i], swap_extension(target.string(), ".kanim"), settings, quiet);
-  }, files);
-  if (json) {
-    nlohmann::json all = nlohmann::json::array();
-    for (const auto& r : results)
-      if (!r.is_null()) all.push_back(r);
-    std::cout << nlohmann::json{{"files", all}, {"failed", files.size() - all.size()}}.dump() << "\n";
-  } else if (g.verbosity > 1) {
-    for (const auto& r : results)
-      if (!r.is_null()) print_line(r);
-  }
-  if (files.empty()) fail(kBadInput, in + ": no .bvh files found");
-  return code;
+  if (in != "-" && std::filesystem::is_directory(in, ec)) return encode_directory(in, out, settings, args, json, g);
+  if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".kanim");
+  if (json && out == "-") fail(kUsage, "--json and the .kanim would both go to standard output: give -o FILE");
+  settings.threads = thread_count(args);  // one file: its channels in parallel
+  const Encoded e = encode_one(in, out, settings, args.has("--error"), g);
+  if (json) std::cout << json_text(e.summary) << "\n";
+  else if (g.verbosity > 0) std::cerr << human_line(e.summary) << "\n";
+  print_warning(e, g);
+  return kOk;
 }
 
 }  // namespace keyanim::cli

@@ -1,6 +1,7 @@
 // keyanim eval: compression against reconstruction error, for files and tolerances.
 #include <zstd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -8,6 +9,8 @@
 
 #include "batch.h"
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/metrics.h"
@@ -25,7 +28,9 @@ const char* const kEvalHelp =
     "encode and decode times. Nothing is written.\n"
     "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
     "  -j N                  threads (default: one per core)\n"
-    "  --json                one JSON object on standard output\n";
+    "  --json                one JSON object on standard output\n"
+    "With --keys other than error, --error only guides quantization: the error reached is\n"
+    "reported as it is, under the heading --error, with a warning where it exceeds a given --error.\n";
 
 namespace {
 
@@ -40,9 +45,10 @@ size_t zstd19_size(const std::vector<uint8_t>& text) {
 
 nlohmann::json eval_file(const std::string& path, const std::vector<offline::EncodeSettings>& runs,
                          const std::vector<std::string>& labels, const Globals& g) {
-  const std::vector<uint8_t> text = read_input(path);
+  const std::vector<uint8_t> text = read_input(path, Kind::bvh, g);
   const auto t0 = Clock::now();
   const offline::Motion m = load_bvh_bytes(path, text, g);
+  check_settings_for(runs.front(), m, path);
   const double parse_ms = ms(t0);
   const double raw = 4.0 * m.frame_count * m.channel_count();
   const size_t z19 = zstd19_size(text);
@@ -69,16 +75,25 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
     const double decode_ms = ms(td);
     const offline::ErrorReport e = offline::measure_error(m, back);
     const double n = double(bytes.size());
-    file["results"].push_back({{"tolerance", labels[r]},
-                               {"tolerance_units", enc.tolerance_units},
-                               {"keys", enc.total_keys},
-                               {"kanim_bytes", bytes.size()},
-                               {"ratio_raw_f32", raw / n},
-                               {"ratio_bvh", double(text.size()) / n},
-                               {"ratio_bvh_zstd19", double(z19) / n},
-                               {"error", error_json(m.skeleton, e)},
-                               {"encode_ms", encode_ms},
-                               {"decode_ms", decode_ms}});
+    nlohmann::json result = {{"keys", enc.total_keys},
+                      {"kanim_bytes", bytes.size()},
+                      {"ratio_raw_f32", raw / n},
+                      {"ratio_bvh", double(text.size()) / n},
+                      {"ratio_bvh_zstd19", double(z19) / n},
+                      {"error", error_json(m.skeleton, e)},
+                      {"encode_ms", encode_ms},
+                      {"decode_ms", decode_ms}};
+    // Only error mode applies the tolerance; the other modes say whether --error held.
+    if (runs[r].key_mode == offline::KeyMode::error) {
+      result["tolerance"] = labels[r];
+      result["tolerance_units"] = enc.tolerance_units;
+    } else {
+      result["error_limit"] = labels[r];
+      result["error_limit_units"] = enc.tolerance_units;
+      result["error_limit_met"] = e.max_error <= enc.tolerance_units;
+      result["warning"] = tolerance_warning(runs[r], enc.tolerance_units, e.max_error);
+    }
+    file["results"].push_back(std::move(result));
   }
   return file;
 }
@@ -90,6 +105,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {"--json"});
   if (args.positional().empty()) fail(kUsage, "eval needs at least one BVH file or directory");
+  if (std::count(args.positional().begin(), args.positional().end(), "-") > 1)
+    fail(kUsage, "only one input can be standard input");
   std::vector<std::string> labels{"0.05%", "0.5%"};
   if (auto list = args.get("--error")) {
     labels.clear();
@@ -112,25 +129,38 @@ int cmd_eval(const Argv& argv, Globals& g) {
   const int code = run_batch(files.size(), thread_count(args), g,
                              [&](size_t i) { results[i] = eval_file(files[i], runs, labels, quiet); }, files);
 
+  // Warnings only when --error was given: the default list is not a request.
+  for (auto& f : results) {
+    if (f.is_null()) continue;
+    for (auto& r : f["results"]) {
+      if (!r.contains("warning")) continue;
+      const std::string w = r["warning"].get<std::string>();
+      if (!w.empty() && args.has("--error") && g.verbosity > 0)
+        std::cerr << "keyanim: warning: " << printable(f["file"].get<std::string>() + ": " + w) << "\n";
+      r.erase("warning");
+    }
+  }
   if (args.has("--json")) {
     nlohmann::json all = nlohmann::json::array();
     for (const auto& r : results)
       if (!r.is_null()) all.push_back(r);
-    std::cout << nlohmann::json{{"files", all}}.dump() << "\n";
+    std::cout << json_text({{"files", all}}) << "\n";
     return code;
   }
-  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s\n", "file", "tolerance", "keys", "bytes", "x raw",
-              "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms");
+  const bool applied = runs.front().key_mode == offline::KeyMode::error;  // else --error is not a tolerance
+  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s\n", "file", applied ? "tolerance" : "--error", "keys",
+              "bytes", "x raw", "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms");
   for (const auto& f : results) {
     if (f.is_null()) continue;
-    std::string name = f["file"].get<std::string>();
+    std::string name = printable(f["file"].get<std::string>());
     if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
     for (const auto& r : f["results"])
       std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f\n", name.c_str(),
-                  r["tolerance"].get<std::string>().c_str(), r["keys"].get<unsigned long long>(),
-                  r["kanim_bytes"].get<unsigned long long>(), r["ratio_raw_f32"].get<double>(),
-                  r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(), r["error"]["max"].get<double>(),
-                  r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(), r["decode_ms"].get<double>());
+                  printable(r[applied ? "tolerance" : "error_limit"].get<std::string>()).c_str(),
+                  r["keys"].get<unsigned long long>(), r["kanim_bytes"].get<unsigned long long>(),
+                  r["ratio_raw_f32"].get<double>(), r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(),
+                  r["error"]["max"].get<double>(), r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(),
+                  r["decode_ms"].get<double>());
   }
   return code;
 }

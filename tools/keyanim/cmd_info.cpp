@@ -4,6 +4,8 @@
 #include <set>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/version.h"
 #include "report.h"
@@ -38,13 +40,15 @@ nlohmann::json skeleton_json(const Skeleton& s) {
           {"rotation_orders", std::vector<std::string>(orders.begin(), orders.end())}};
 }
 
+// Names and notes come from the file: printable() keeps their bytes from acting on a terminal.
 void print_text(const nlohmann::json& j) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (it->is_object()) {
       std::cout << it.key() << ":\n";
-      for (auto sub = it->begin(); sub != it->end(); ++sub) std::cout << "  " << sub.key() << ": " << sub->dump() << "\n";
+      for (auto sub = it->begin(); sub != it->end(); ++sub)
+        std::cout << "  " << sub.key() << ": " << printable(json_text(*sub)) << "\n";
     } else {
-      std::cout << it.key() << ": " << (it->is_string() ? it->get<std::string>() : it->dump()) << "\n";
+      std::cout << it.key() << ": " << printable(it->is_string() ? it->get<std::string>() : json_text(*it)) << "\n";
     }
   }
 }
@@ -55,7 +59,7 @@ int cmd_info(const Argv& argv, Globals& g) {
   const Args args(argv, {}, {"--json"});
   if (args.positional().size() != 1) fail(kUsage, "info takes one file");
   const std::string in = args.positional()[0];
-  const std::vector<uint8_t> bytes = read_input(in);
+  const std::vector<uint8_t> bytes = read_input(in, Kind::either, g);
   nlohmann::json j;
   if (!looks_like_kanim(bytes)) {
     const offline::Motion m = load_bvh_bytes(in, bytes, g);
@@ -103,7 +107,7 @@ int cmd_info(const Argv& argv, Globals& g) {
     j["memory_bytes"] = clip.memory_bytes();
     j["encoder_notes"] = clip.encoder_notes();
   }
-  if (args.has("--json")) std::cout << j.dump() << "\n"; else print_text(j);
+  if (args.has("--json")) std::cout << json_text(j) << "\n"; else print_text(j);
   return kOk;
 }
 

@@ -4,6 +4,8 @@
 #include <iostream>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "figures.h"
 #include "settings.h"
 
@@ -44,35 +46,40 @@ int cmd_plot(const Argv& argv, Globals& g) {
   const offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];
 
-  const offline::Motion motion = load_bvh(in, g);
-  std::string error;
-  const std::optional<uint32_t> channel = find_channel(motion.skeleton, *spec, error);
-  if (!channel) fail(kUsage, in + ": " + error);
-  if (motion.frame_count == 0) fail(kBadInput, in + ": no frames to plot");
-
   std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
   if (out.empty()) {
     const size_t colon = spec->rfind(':');
     out = in == "-" ? "-"
                     : swap_extension(in, "") + "-" + file_safe(spec->substr(0, colon)) + "-" +
-                          spec->substr(colon + 1) + ".svg";
+                          file_safe(spec->substr(colon == std::string::npos ? spec->size() : colon + 1)) + ".svg";
   }
-  const std::string label = in == "-" ? "(stdin)" : std::filesystem::path(in).filename().string();
   FrameRange range;
-  if (auto text = args.get("--frames")) {
-    const size_t colon = text->find(':');
-    if (colon == std::string::npos) fail(kUsage, "--frames expects A:B, got '" + *text + "'");
-    if (colon > 0) range.first = parse_uint("--frames", text->substr(0, colon));
-    if (colon + 1 < text->size()) range.last = parse_uint("--frames", text->substr(colon + 1));
-    if (range.first > range.last || range.first >= motion.frame_count)
-      fail(kUsage, "--frames " + *text + " holds no frame of " + in + " (frames 0.." +
-                       std::to_string(motion.frame_count - 1) + ")");
+  const std::optional<std::string> frames = args.get("--frames");
+  if (frames) {
+    const size_t colon = frames->find(':');
+    if (colon == std::string::npos) fail(kUsage, "--frames expects A:B, got '" + *frames + "'");
+    if (colon > 0) range.first = parse_uint("--frames", frames->substr(0, colon));
+    if (colon + 1 < frames->size()) range.last = parse_uint("--frames", frames->substr(colon + 1));
   }
+
+  Input input(in, g);
+  Output output(out, false, g, ids_of({&input}));
+  const offline::Motion motion = load_bvh_bytes(in, input.read(Kind::bvh), g);
+  std::string error;
+  const std::optional<uint32_t> channel = find_channel(motion.skeleton, *spec, error);
+  if (!channel) fail(kUsage, in + ": " + error);
+  if (motion.frame_count == 0) fail(kBadInput, in + ": no frames to plot");
+  check_settings_for(settings, motion, in);
+  if (frames && (range.first > range.last || range.first >= motion.frame_count))
+    fail(kUsage, "--frames " + *frames + " holds no frame of " + in + " (frames 0.." +
+                     std::to_string(motion.frame_count - 1) + ")");
+  const std::string label = in == "-" ? "(stdin)" : std::filesystem::path(in).filename().string();
   ChannelPlot plot;
   if (!plot_channel(motion, settings, *channel, label, plot, error, range)) fail(kBadInput, in + ": " + error);
-  write_output(out, plot.svg, false, g);
+  output.write(plot.svg);
+  output.commit();
   if (g.verbosity > 0)
-    std::cerr << in << " -> " << out << ": " << *spec << ", " << plot.key_count << " keys shown of "
+    std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << plot.key_count << " keys shown of "
               << plot.channel_keys << ", max channel error " << plot.max_channel_error << "\n";
   return kOk;
 }

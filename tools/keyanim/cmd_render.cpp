@@ -2,8 +2,11 @@
 // default the original beside (overlaid on) its reconstruction.
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "figures.h"
 #include "keyanim/clip.h"
 #include "keyanim/offline/container.h"
@@ -26,6 +29,40 @@ const char* const kRenderHelp =
     "  -o, --output FILE     SVG output (default: IN without extension + -frameN.svg;\n"
     "                        '-' = standard output)\n";
 
+namespace {
+
+// One input's poses: a BVH's motion (all of it: it is no larger than the file), or a clip, of
+// which only the frame drawn is decoded, whatever frame count it declares.
+struct Poses {
+  std::optional<offline::Motion> motion;
+  std::optional<Clip> clip;
+
+  Poses(const std::string& path, Input& input, const Globals& g) {
+    const std::vector<uint8_t> bytes = input.read(Kind::either);
+    if (looks_like_kanim(bytes)) clip = load_kanim(path, bytes);
+    else motion = load_bvh_bytes(path, bytes, g);
+  }
+  uint32_t frame_count() const { return clip ? clip->frame_count() : motion->frame_count; }
+  // Frame `frame` (< frame_count()) alone, as a one-frame motion.
+  offline::Motion one_frame(uint32_t frame) const {
+    offline::Motion m;
+    if (clip) {
+      offline::ResampleOptions o;
+      o.first_frame = o.last_frame = frame;
+      std::string error;
+      if (!offline::decode_motion(*clip, o, m, error)) fail(kBadInput, error);
+      return m;
+    }
+    m.skeleton = motion->skeleton;
+    m.frame_count = 1;
+    m.frame_time = motion->frame_time;
+    m.values.assign(motion->frame(frame), motion->frame(frame) + motion->channel_count());
+    return m;
+  }
+};
+
+}  // namespace
+
 int cmd_render(const Argv& argv, Globals& g) {
   std::set<std::string> valued{"-o", "--output", "--frame", "--against"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
@@ -35,55 +72,59 @@ int cmd_render(const Argv& argv, Globals& g) {
   const std::string in = args.positional()[0];
   const auto against = args.get("--against");
   if (against && *against == "-" && in == "-") fail(kUsage, "only one input can be standard input");
+  const std::optional<uint32_t> frame_option = args.has("--frame") ? std::optional(args.get_uint("--frame", 0)) : std::nullopt;
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
 
-  const std::vector<uint8_t> bytes = read_input(in);
-  const bool in_is_kanim = looks_like_kanim(bytes);
-  offline::Motion first;
-  if (in_is_kanim) {
-    std::string error;
-    if (!offline::decode_motion(load_kanim(in, bytes), {}, first, error)) fail(kBadInput, in + ": " + error);
-  } else {
-    first = load_bvh_bytes(in, bytes, g);
-  }
-  if (first.frame_count == 0) fail(kBadInput, in + ": no frames to render");
-  const uint32_t frame = args.get_uint("--frame", first.frame_count / 2);
-  if (frame >= first.frame_count)
-    fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(first.frame_count - 1) + ")");
+  Input input(in, g);
+  std::optional<Input> other;
+  if (against) other.emplace(*against, g);
+  const Poses poses(in, input, g);
+  if (poses.frame_count() == 0) fail(kBadInput, in + ": no frames to render");
+  const uint32_t frame = frame_option.value_or(poses.frame_count() / 2);
+  if (frame >= poses.frame_count())
+    fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(poses.frame_count() - 1) + ")");
+  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  if (out.empty()) out = in == "-" ? "-" : swap_extension(in, "") + "-frame" + std::to_string(frame) + ".svg";
+  Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}));
 
+  const offline::Motion first = poses.one_frame(frame);
   offline::Motion second;
   std::vector<PoseSeries> series{{&first, name_of(in)}};
   std::string title = name_of(in) + ", frame " + std::to_string(frame);
   if (against) {
-    second = load_motion(*against, g);
-    if (!same_skeleton(first.skeleton, second.skeleton))
-      fail(kBadInput, *against + ": not the same skeleton as " + in);
-    if (frame >= second.frame_count)
-      fail(kUsage, *against + " has no frame " + std::to_string(frame) + " (" + std::to_string(second.frame_count) + " frames)");
+    const Poses theirs(*against, *other, g);
+    const Skeleton& skeleton = theirs.clip ? theirs.clip->skeleton() : theirs.motion->skeleton;
+    if (!same_skeleton(first.skeleton, skeleton)) fail(kBadInput, *against + ": not the same skeleton as " + in);
+    if (frame >= theirs.frame_count())
+      fail(kUsage, *against + " has no frame " + std::to_string(frame) + " (" + std::to_string(theirs.frame_count()) + " frames)");
+    second = theirs.one_frame(frame);
     series.push_back({&second, name_of(*against)});
     title += " against " + name_of(*against);
-  } else if (!in_is_kanim) {
+  } else if (poses.motion) {
+    check_settings_for(settings, *poses.motion, in);
     offline::EncodeResult result;
     std::string error;
-    if (!offline::encode(first, settings, result, error)) fail(kBadInput, in + ": " + error);
-    if (!offline::decode_motion(offline::to_clip(result.clip), {}, second, error)) fail(kBadInput, in + ": " + error);
+    if (!offline::encode(*poses.motion, settings, result, error)) fail(kBadInput, in + ": " + error);
+    const Clip clip = offline::to_clip(result.clip);
+    offline::ResampleOptions o;
+    o.first_frame = o.last_frame = frame;
+    if (!offline::decode_motion(clip, o, second, error)) fail(kBadInput, in + ": " + error);
     series.front().label = "original";
     series.push_back({&second, "reconstruction (" + std::to_string(result.total_keys) + " keys, " +
                                    settings_text(settings, result.tolerance_units) + ")"});
     title += ": original and reconstruction";
   }
 
-  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
-  if (out.empty()) out = in == "-" ? "-" : swap_extension(in, "") + "-frame" + std::to_string(frame) + ".svg";
-  const PoseFigure fig = render_pose(series, frame, title);
-  write_output(out, fig.svg, false, g);
+  const PoseFigure fig = render_pose(series, 0, title);
+  output.write(fig.svg);
+  output.commit();
   if (g.verbosity > 0) {
-    std::cerr << in << " -> " << out << ": frame " << frame;
+    std::cerr << printable(in + " -> " + out) << ": frame " << frame;
     if (series.size() == 2)
       std::cerr << ", largest distance " << fig.worst_distance << " ("
-                << figure_node_name(first.skeleton, fig.worst_node) << ")";
+                << printable(figure_node_name(first.skeleton, fig.worst_node)) << ")";
     std::cerr << "\n";
   }
   return kOk;

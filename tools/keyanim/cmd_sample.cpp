@@ -3,6 +3,8 @@
 #include <iostream>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/offline/fk.h"
 #include "report.h"
 
@@ -17,19 +19,18 @@ const char* const kSampleHelp =
     "  --world               world positions by forward kinematics instead of channel values\n"
     "  --json                one JSON object on standard output\n";
 
-int cmd_sample(const Argv& argv, Globals&) {
+int cmd_sample(const Argv& argv, Globals& g) {
   const Args args(argv, {"--frame", "--time", "--joint"}, {"--world", "--json"});
   if (args.positional().size() != 1) fail(kUsage, "sample takes one .kanim file");
   if (args.has("--frame") == args.has("--time")) fail(kUsage, "sample needs exactly one of --frame and --time");
   const std::string in = args.positional()[0];
-  const std::vector<uint8_t> bytes = read_input(in);
-  if (!looks_like_kanim(bytes)) fail(kBadInput, in + ": not a .kanim file");
-  const Clip clip = load_kanim(in, bytes);
-  const double pos = args.has("--frame") ? args.get_double("--frame", 0.0)
-                                         : args.get_double("--time", 0.0) / clip.frame_time();
-  if (args.has("--time") && !(clip.frame_time() > 0.0)) fail(kUsage, "the clip has no frame time; use --frame");
+  const double frame = args.get_double("--frame", 0.0), time = args.get_double("--time", 0.0);
+  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g));
+  // A clip without frames, or without a frame time for --time, cannot give what was asked.
+  if (clip.frame_count() == 0) fail(kBadInput, in + ": the clip has no frames to sample");
+  if (args.has("--time") && !(clip.frame_time() > 0.0)) fail(kBadInput, in + ": the clip has no frame time; use --frame");
+  const double pos = args.has("--frame") ? frame : time / clip.frame_time();
   std::vector<float> row(clip.channel_count());
-  if (clip.frame_count() == 0) fail(kUsage, "the clip has no frames");
   if (const Status s = clip.sample(pos, row); s != Status::ok) fail(kUsage, std::string("cannot sample: ") + status_string(s));
 
   const Skeleton& sk = clip.skeleton();
@@ -37,7 +38,7 @@ int cmd_sample(const Argv& argv, Globals&) {
   if (auto name = args.get("--joint")) {
     for (uint32_t i = 0; i < sk.joints.size() && only < 0; ++i)
       if (sk.joints[i].name == *name && !sk.joints[i].end_site) only = int32_t(i);
-    if (only < 0) fail(kUsage, "no joint named '" + *name + "'");
+    if (only < 0) fail(kUsage, in + ": no joint named '" + *name + "'");
   }
   std::vector<double> values(row.begin(), row.end());
   std::vector<offline::Vec3> world;
@@ -57,11 +58,11 @@ int cmd_sample(const Argv& argv, Globals&) {
     joints.push_back(e);
   }
   if (args.has("--json")) {
-    std::cout << nlohmann::json{{"file", in}, {"frame_position", pos}, {"time", pos * clip.frame_time()}, {"joints", joints}}.dump() << "\n";
+    std::cout << json_text({{"file", in}, {"frame_position", pos}, {"time", pos * clip.frame_time()}, {"joints", joints}}) << "\n";
     return kOk;
   }
   for (const auto& e : joints) {
-    std::cout << e["name"].get<std::string>();
+    std::cout << printable(e["name"].get<std::string>());
     for (auto it = e.begin(); it != e.end(); ++it)
       if (it.key() != "name") std::cout << " " << it.key() << "=" << it->dump();
     std::cout << "\n";

@@ -1,7 +1,10 @@
 // keyanim verify: a .kanim is intact, and (with --against) within an error of the original.
 #include <iostream>
+#include <optional>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
@@ -27,28 +30,30 @@ int cmd_verify(const Argv& argv, Globals& g) {
   if (args.positional().size() != 1) fail(kUsage, "verify takes one .kanim file");
   if (args.has("--max-error") && !args.has("--against")) fail(kUsage, "--max-error needs --against ORIG.bvh");
   const std::string in = args.positional()[0];
-  const std::vector<uint8_t> bytes = read_input(in);
-  if (!looks_like_kanim(bytes)) fail(kBadInput, in + ": not a .kanim file (bad signature)");
-  const Clip clip = load_kanim(in, bytes);
+  if (args.get("--against") == "-" && in == "-") fail(kUsage, "only one input can be standard input");
+  std::optional<offline::EncodeSettings> limit;  // parsed before any work
+  if (auto text = args.get("--max-error")) parse_tolerance(*text, limit.emplace(), "--max-error");
+  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g));
   nlohmann::json j = {{"file", in}, {"valid", true}};
   bool ok = true;
   std::string why;
   if (auto orig_path = args.get("--against")) {
     const offline::Motion orig = load_bvh(*orig_path, g);
-    offline::Motion back;
-    std::string error;
-    if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, in + ": " + error);
-    const bool same_layout = orig.frame_count == back.frame_count && orig.channel_count() == back.channel_count() &&
-                             orig.skeleton.joints.size() == back.skeleton.joints.size();
+    // Compared before decoding, so that the work follows the original's size, not what the
+    // clip declares.
+    const bool same_layout = orig.frame_count == clip.frame_count() && orig.channel_count() == clip.channel_count() &&
+                             orig.skeleton.joints.size() == clip.skeleton().joints.size();
     if (!same_layout) {
       ok = false;
       why = "the clip's skeleton or frame count differs from " + *orig_path;
     } else {
+      offline::Motion back;
+      std::string error;
+      if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, in + ": " + error);
       const offline::ErrorReport e = offline::measure_error(orig, back);
       j["error"] = error_json(orig.skeleton, e);
-      if (auto limit = args.get("--max-error")) {
-        offline::EncodeSettings s;
-        parse_tolerance(*limit, s);
+      if (limit) {
+        const offline::EncodeSettings& s = *limit;
         const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::reference_size(orig) : s.tolerance;
         j["max_error_allowed"] = units;
         if (!(e.max_error <= units)) {
@@ -56,13 +61,13 @@ int cmd_verify(const Argv& argv, Globals& g) {
           why = "error " + std::to_string(e.max_error) + " exceeds " + std::to_string(units);
         }
       }
-      if (!args.has("--json") && g.verbosity > 0) std::cerr << in << ": error " << error_text(orig.skeleton, e) << "\n";
+      if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + error_text(orig.skeleton, e)) << "\n";
     }
   }
   j["ok"] = ok;
-  if (args.has("--json")) std::cout << j.dump() << "\n";
+  if (args.has("--json")) std::cout << json_text(j) << "\n";
   if (!ok) fail(kCheckFailed, in + ": " + why);
-  if (!args.has("--json") && g.verbosity > 0) std::cerr << in << ": ok\n";
+  if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in) << ": ok\n";
   return kOk;
 }
 

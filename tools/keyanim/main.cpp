@@ -3,8 +3,12 @@
 #include <cstring>
 #include <iostream>
 #include <new>
+#include <optional>
+#include <string>
 
 #include "commands.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/version.h"
 #include "settings.h"
 
@@ -36,15 +40,25 @@ const char* const kGlobalHelp =
     "  -V, --version         tool and format versions (-qV: the bare version)\n"
     "  -v, --verbose         more messages on standard error\n"
     "  -q, --quiet           no messages but errors\n"
-    "  -f, --force           overwrite existing outputs; allow binary output to a terminal\n"
-    "exit codes: 0 ok, 1 usage, 2 input unreadable or malformed, 3 unsupported version or feature,\n"
-    "            4 output cannot be written, 5 a requested check failed\n";
+    "  -f, --force           overwrite existing outputs (never an input); allow binary output\n"
+    "                        to a terminal\n"
+    "  --max-input SIZE      largest input file read, in bytes (K, M, G: powers of 1024);\n"
+    "                        default 1G\n"
+    "  --max-values N        most values (frames x channels) a decode may make; default 256M\n";
 
 void print_main_help() {
   std::cout << "keyanim " KEYANIM_VERSION_STRING " - skeletal motion as keyframes, rebuilt by Cardinal splines\n"
                "usage: keyanim COMMAND [options] INPUT [-o OUTPUT]\n\ncommands:\n";
   for (const Command& c : kCommands) std::printf("  %-8s %s\n", c.name, c.summary);
-  std::cout << "\n" << kGlobalHelp << "Run 'keyanim COMMAND --help' for a command's options.\n";
+  std::cout << "\n" << kGlobalHelp << "\n" << kExitCodeTable << "\nRun 'keyanim COMMAND --help' for a command's options.\n";
+}
+
+// The value of global option `name` at argv[i] ("--name V" or "--name=V"), advancing i past it.
+std::optional<std::string> global_value(const std::string& a, const std::string& name, int argc, char** argv, int& i) {
+  if (a.rfind(name + "=", 0) == 0) return a.substr(name.size() + 1);
+  if (a != name) return std::nullopt;
+  if (i + 1 >= argc) fail(kUsage, "option " + name + " needs a value");
+  return std::string(argv[++i]);
 }
 
 int run(int argc, char** argv) {
@@ -62,6 +76,8 @@ int run(int argc, char** argv) {
     else if (a == "-q" || a == "--quiet") g.verbosity = 0;
     else if (a == "-f" || a == "--force") g.force = true;
     else if (a == "-qV" || a == "-Vq") version = true, g.verbosity = 0;
+    else if (auto in = global_value(a, "--max-input", argc, argv, i)) g.limits.max_input_bytes = parse_size("--max-input", *in);
+    else if (auto n = global_value(a, "--max-values", argc, argv, i)) g.limits.max_values = parse_size("--max-values", *n);
     else rest.push_back(a);
   }
   if (version) {
@@ -79,12 +95,12 @@ int run(int argc, char** argv) {
   for (const Command& c : kCommands) {
     if (name != c.name) continue;
     if (help) {
-      std::cout << *c.help << (c.encoder_options ? kEncodeOptionsHelp : "") << "\n" << kGlobalHelp;
+      std::cout << *c.help << (c.encoder_options ? kEncodeOptionsHelp : "") << "\n" << kGlobalHelp << "\n" << kExitCodeTable;
       return kOk;
     }
     return c.run(rest, g);
   }
-  std::cerr << "keyanim: unknown command '" << name << "'\nTry 'keyanim --help'.\n";
+  std::cerr << "keyanim: unknown command '" << printable(name) << "'\nTry 'keyanim --help'.\n";
   return kUsage;
 }
 
@@ -94,14 +110,17 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   using namespace keyanim::cli;
   install_interrupt_cleanup();
+  Failure failure;
   try {
     return run(argc, argv);
   } catch (const Failure& f) {
-    std::cerr << "keyanim: " << f.message << "\n";
-    if (f.code == kUsage) std::cerr << "Try 'keyanim --help'.\n";
-    return f.code;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "keyanim: out of memory\n";
-    return kBadInput;
+    failure = f;
+  } catch (const std::exception& e) {
+    failure = failure_of(e);
+  } catch (...) {
+    failure = {kInternal, "internal error (a bug in keyanim; please report it): an unknown exception"};
   }
+  std::cerr << "keyanim: " << printable(failure.message) << "\n";
+  if (failure.code == kUsage) std::cerr << "Try 'keyanim --help'.\n";
+  return failure.code;
 }

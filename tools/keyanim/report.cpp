@@ -26,4 +26,15 @@ std::string error_text(const Skeleton& s, const offline::ErrorReport& e) {
   return buf;
 }
 
+std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance_units, double max_error) {
+  if (s.key_mode == offline::KeyMode::error || max_error <= tolerance_units) return {};
+  const std::string mode = s.key_mode == offline::KeyMode::uniform ? "uniform:" + std::to_string(s.uniform_interval)
+                           : s.key_mode == offline::KeyMode::manual  ? "manual"
+                                                                     : "curvature";
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "error max %.6g exceeds --error %.6g%s (%.6g units), which --keys %s does not enforce",
+                max_error, s.tolerance, s.tolerance_in_percent ? "%" : "", tolerance_units, mode.c_str());
+  return buf;
+}
+
 }  // namespace keyanim::cli

@@ -14,4 +14,8 @@ nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e);
 // "max 0.081 (LeftHand, frame 713), rms 0.012"
 std::string error_text(const Skeleton& s, const offline::ErrorReport& e);
 
+// Empty, or a warning when --error was given with a key mode that does not apply it (uniform,
+// manual, curvature) and the error reached exceeds it.
+std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance_units, double max_error);
+
 }  // namespace keyanim::cli

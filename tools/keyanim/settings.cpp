@@ -1,5 +1,7 @@
 #include "settings.h"
 
+#include "keyanim/offline/keyframes.h"
+
 namespace keyanim::cli {
 
 const char* const kEncodeOptionsHelp =
@@ -9,16 +11,18 @@ const char* const kEncodeOptionsHelp =
     "  --keys MODE           error (default): fewest keys within --error;\n"
     "                        uniform:N every N-th frame (N >= 1); manual:F1,F2,... those frames;\n"
     "                        curvature: curvature feature points. First and last frame always.\n"
+    "                        Only error mode applies --error as a tolerance; the others report\n"
+    "                        the error reached (and warn when it exceeds a given --error).\n"
     "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
     "                        least squares per channel, kept where it saves keys.\n"
     "  --level N             zstd level, 1..22. Default 19.\n";
 
-void parse_tolerance(const std::string& text, offline::EncodeSettings& s) {
+void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
   std::string t = text;
   s.tolerance_in_percent = !t.empty() && t.back() == '%';
   if (s.tolerance_in_percent) t.pop_back();
-  s.tolerance = parse_double("--error", t);
-  if (!(s.tolerance > 0.0)) fail(kUsage, "--error must be positive, got '" + text + "'");
+  s.tolerance = parse_double(option, t);
+  if (!(s.tolerance > 0.0)) fail(kUsage, option + " must be positive, got '" + text + "'");
 }
 
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
@@ -44,6 +48,13 @@ void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
   } else {
     fail(kUsage, "--keys expects error, uniform:N, manual:F1,F2,... or curvature, got '" + text + "'");
   }
+}
+
+void check_settings_for(const offline::EncodeSettings& s, const offline::Motion& motion, const std::string& path) {
+  std::vector<uint32_t> keys;
+  std::string error;
+  if (s.key_mode == offline::KeyMode::manual && !offline::manual_keys(s.manual_frames, motion.frame_count, keys, error))
+    fail(kUsage, path + ": --keys manual: " + error);
 }
 
 offline::EncodeSettings encode_settings(const Args& args, bool read_error) {

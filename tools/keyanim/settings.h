@@ -4,6 +4,7 @@
 
 #include "cli.h"
 #include "keyanim/offline/encode.h"
+#include "keyanim/offline/motion.h"
 
 namespace keyanim::cli {
 
@@ -14,9 +15,13 @@ inline const char* const kEncodeValuedOptions[] = {"--error", "--keys", "--tensi
 // read_error = false leaves --error to the caller (eval takes a list).
 offline::EncodeSettings encode_settings(const Args& args, bool read_error = true);
 // "0.05%" or "0.1" -> settings.tolerance / tolerance_in_percent; usage error if malformed.
-void parse_tolerance(const std::string& text, offline::EncodeSettings& s);
+void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option = "--error");
 // "error", "uniform:N", "manual:F1,F2,...", "curvature".
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s);
+
+// Usage error (exit 1) when `s` asks for what `motion` (read from `path`) does not have: a
+// --keys manual frame past its last frame. Checked before encoding.
+void check_settings_for(const offline::EncodeSettings& s, const offline::Motion& motion, const std::string& path);
 
 // The help lines for these options (defaults and ranges).
 extern const char* const kEncodeOptionsHelp;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "escape.h"
+
 namespace keyanim::svg {
 
 std::string number(double v, int decimals) {
@@ -27,18 +29,18 @@ std::string compact(double v, int decimals) {
 }
 
 std::string escape(std::string_view text) {
+  // printable() first: XML 1.0 allows neither most control characters nor bytes that are not
+  // UTF-8, and both may come from an input's names.
+  const std::string safe = cli::printable(text);
   std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
+  out.reserve(safe.size());
+  for (const char c : safe) {
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
-      default:
-        // Control characters are not allowed in XML 1.0 text.
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n') out += '?';
-        else out += c;
+      default: out += c;
     }
   }
   return out;

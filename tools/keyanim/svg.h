@@ -12,7 +12,8 @@ namespace keyanim::svg {
 std::string number(double v, int decimals = 1);
 // number() without the leading zero of |v| < 1 (".5", "-.25"): for long path data.
 std::string compact(double v, int decimals = 1);
-// Escapes & < > " for use in text and attribute values.
+// Escapes & < > " for use in text and attribute values, after printable() (escape.h): what XML
+// cannot hold (control characters, bytes that are not UTF-8) becomes visible \xHH text.
 std::string escape(std::string_view text);
 // ` name="value"` with the value escaped: builds the `attrs` arguments below.
 std::string attr(std::string_view name, std::string_view value);

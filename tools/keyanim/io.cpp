@@ -1,0 +1,324 @@
+#include "io.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+
+#include "keyanim/offline/bvh.h"
+
+namespace keyanim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Temporary outputs being written, so that an interrupt removes them (no partial files). Slots
+// are fixed arrays: the signal handler may only touch memory that is already there.
+constexpr int kMaxTemps = 256;
+char g_temp_names[kMaxTemps][4096];
+std::atomic<bool> g_temp_used[kMaxTemps];
+
+int register_temp(const std::string& name) {
+  if (name.size() >= sizeof g_temp_names[0]) return -1;
+  for (int i = 0; i < kMaxTemps; ++i) {
+    bool expected = false;
+    if (g_temp_used[i].load() || !g_temp_used[i].compare_exchange_strong(expected, true)) continue;
+    std::memcpy(g_temp_names[i], name.c_str(), name.size() + 1);
+    return i;
+  }
+  return -1;
+}
+
+void unregister_temp(int slot) {
+  if (slot >= 0) g_temp_used[slot].store(false);
+}
+
+extern "C" void remove_temps_and_die(int sig) {
+  for (int i = 0; i < kMaxTemps; ++i)
+    if (g_temp_used[i].load()) ::unlink(g_temp_names[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+// Writes everything, retrying short writes; 0 or the errno that stopped it.
+int write_all(int fd, std::string_view data) {
+  size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n < 0 ? errno : EIO;
+    done += size_t(n);
+  }
+  return 0;
+}
+
+std::optional<FileId> regular_id(const struct stat& st) {
+  if (!S_ISREG(st.st_mode)) return std::nullopt;
+  return FileId{st.st_dev, st.st_ino};
+}
+
+std::optional<FileId> fd_id(int fd) {
+  struct stat st;
+  if (::fstat(fd, &st) != 0) return std::nullopt;
+  return regular_id(st);
+}
+
+bool contains(const std::vector<FileId>& ids, const std::optional<FileId>& id) {
+  return id && std::find(ids.begin(), ids.end(), *id) != ids.end();
+}
+
+// Reads into `bytes` until it holds `want` bytes or the input ends; false at the end.
+bool fill(int fd, const std::string& path, std::vector<uint8_t>& bytes, size_t want) {
+  while (bytes.size() < want) {
+    const size_t at = bytes.size();
+    bytes.resize(want);
+    const ssize_t n = ::read(fd, bytes.data() + at, want - at);
+    bytes.resize(at + size_t(std::max<ssize_t>(n, 0)));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(kBadInput, path + ": read error: " + std::strerror(errno));
+    if (n == 0) return false;
+  }
+  return true;
+}
+
+enum class Start { yes, no, undecided };
+
+// Whether `b` can start BVH text: blanks and a UTF-8 byte order mark, then HIERARCHY in any
+// case (what the reader accepts). Undecided while only blanks have been seen.
+Start bvh_start(const std::vector<uint8_t>& b) {
+  size_t i = b.size() >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF ? 3 : 0;
+  while (i < b.size() && (b[i] == ' ' || (b[i] >= '\t' && b[i] <= '\r'))) ++i;
+  const char* word = "hierarchy";
+  for (size_t k = 0; k < 9; ++k, ++i) {
+    if (i == b.size()) return Start::undecided;
+    if (std::tolower(b[i]) != word[k]) return Start::no;
+  }
+  return Start::yes;
+}
+
+// Fails (exit 2) unless the first bytes read can start a `kind` file, naming what is wrong as
+// the reader would for BVH text (file:line:column). Undecided when only blanks were read.
+Start check_start(const std::string& path, const std::vector<uint8_t>& b, Kind kind) {
+  static const uint8_t kMagic[4] = {0x89, 'K', 'A', 'N'};
+  const bool kanim = std::equal(b.begin(), b.begin() + std::min<size_t>(b.size(), 4), kMagic) && !b.empty();
+  if (kind == Kind::kanim) {
+    if (!kanim && !b.empty()) fail(kBadInput, path + ": not a .kanim file (bad signature)");
+    return Start::yes;
+  }
+  if (kanim && b.size() >= 4) {
+    if (kind == Kind::bvh) fail(kBadInput, path + ": is a .kanim file, expected BVH text");
+    return Start::yes;
+  }
+  const Start s = bvh_start(b);
+  if (s != Start::no) return s;
+  offline::Motion m;
+  offline::BvhError err;
+  const std::string_view text(reinterpret_cast<const char*>(b.data()), b.size());
+  if (!offline::read_bvh(text, path, m, err)) fail(kBadInput, err.to_string());
+  fail(kBadInput, path + ": not BVH text");  // not reached: the reader wants HIERARCHY first
+}
+
+std::string too_large(const std::string& path, uint64_t max) {
+  return path + ": larger than the input limit of " + std::to_string(max) + " bytes (raise it with --max-input SIZE)";
+}
+
+// The parent directory of `path` as a path that can be passed to the system ("." if none).
+fs::path parent_of(const std::string& path) {
+  const fs::path p(path);
+  return p.has_parent_path() ? p.parent_path() : fs::path(".");
+}
+
+}  // namespace
+
+void install_interrupt_cleanup() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) std::signal(sig, remove_temps_and_die);
+}
+
+std::optional<FileId> input_id(const std::string& path) {
+  if (path == "-") return fd_id(STDIN_FILENO);
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+  return regular_id(st);
+}
+
+Input::Input(const std::string& path, const Globals& g) : path_(path), max_bytes_(g.limits.max_input_bytes) {
+  if (path == "-") {
+    fd_ = STDIN_FILENO;
+  } else {
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) fail(kBadInput, path + ": cannot open: " + std::strerror(errno));
+  }
+  auto refuse = [&](int code, const std::string& message) {  // the destructor will not run
+    if (fd_ > STDIN_FILENO) ::close(fd_);
+    fail(code, message);
+  };
+  struct stat st;
+  if (::fstat(fd_, &st) != 0) refuse(kBadInput, path + ": cannot read: " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) refuse(kBadInput, path + ": is a directory");
+  if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes_) refuse(kLimit, too_large(path, max_bytes_));
+  id_ = regular_id(st);
+  if (id_) size_hint_ = uint64_t(st.st_size);
+  if (id_ && fd_id(STDOUT_FILENO) == id_)
+    refuse(kOutputFailed, path + ": is also standard output; an input is never written to");
+}
+
+Input::~Input() {
+  if (fd_ > STDIN_FILENO) ::close(fd_);
+}
+
+std::vector<uint8_t> Input::read(Kind kind) {
+  std::vector<uint8_t> bytes;
+  // The first bytes decide whether to read on; then all of a regular file at once (one more
+  // byte to see that it has not grown), or doubling chunks of a stream.
+  uint64_t want = 1 << 16;
+  Start start = Start::undecided;
+  for (bool more = true; more;) {
+    more = fill(fd_, path_, bytes, size_t(std::min(want, max_bytes_ + 1)));
+    if (bytes.size() > max_bytes_) fail(kLimit, too_large(path_, max_bytes_));
+    if (start == Start::undecided) start = check_start(path_, bytes, kind);
+    want = std::max<uint64_t>({want * 2, size_hint_ + 1});
+  }
+  return bytes;
+}
+
+std::vector<uint8_t> read_input(const std::string& path, Kind kind, const Globals& g) {
+  return Input(path, g).read(kind);
+}
+
+offline::Motion load_bvh(const std::string& path, const Globals& g) {
+  return load_bvh_bytes(path, read_input(path, Kind::bvh, g), g);
+}
+
+std::vector<FileId> ids_of(const std::vector<const Input*>& inputs) {
+  std::vector<FileId> ids;
+  for (const Input* in : inputs)
+    if (in->id()) ids.push_back(*in->id());
+  return ids;
+}
+
+Output::Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs)
+    : path_(path), force_(g.force) {
+  if (path == "-") {
+    if (binary && isatty(STDOUT_FILENO) && !g.force)
+      fail(kOutputFailed, "refusing to write binary data to a terminal (use -o FILE, a pipe, or -f)");
+    if (contains(inputs, fd_id(STDOUT_FILENO)))
+      fail(kOutputFailed, "standard output is an input file; an input is never written to");
+    fd_ = STDOUT_FILENO;
+    return;
+  }
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0) {
+    if (contains(inputs, regular_id(st)))
+      fail(kOutputFailed, path + ": is an input; an input is never overwritten, even with -f");
+    if (S_ISDIR(st.st_mode)) fail(kOutputFailed, path + ": is a directory");
+    if (!g.force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
+    // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
+    if (!S_ISREG(st.st_mode)) {
+      fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
+      return;
+    }
+  }
+  // A temporary file beside the target, renamed over it only once complete.
+  const fs::path target(path);
+  std::string tmpl = (target.has_parent_path() ? target.parent_path() / "" : fs::path()).string() + "." +
+                     target.filename().string() + ".tmp.XXXXXX";
+  std::vector<char> name(tmpl.begin(), tmpl.end());
+  name.push_back('\0');
+  fd_ = mkstemp(name.data());
+  if (fd_ < 0) {
+    const int err = errno;
+    const std::string dir = parent_of(path).string();
+    if (err == ENOENT) fail(kOutputFailed, path + ": directory " + dir + " does not exist");
+    if (err == ENOTDIR) fail(kOutputFailed, path + ": " + dir + " is not a directory");
+    fail(kOutputFailed, path + ": cannot create a file in " + dir + ": " + std::strerror(err));
+  }
+  temp_ = name.data();
+  slot_ = register_temp(temp_);
+}
+
+Output::~Output() {
+  if (committed_ || fd_ == STDOUT_FILENO) return;
+  if (fd_ >= 0) ::close(fd_);
+  if (!temp_.empty()) ::unlink(temp_.c_str());
+  unregister_temp(slot_);
+}
+
+void Output::write(std::string_view data) {
+  if (const int err = write_all(fd_, data); err != 0) {
+    if (fd_ == STDOUT_FILENO) fail(kOutputFailed, "-: cannot write standard output: " + std::string(std::strerror(err)));
+    fail(kOutputFailed, path_ + ": cannot write: " + std::strerror(err));
+  }
+}
+
+void Output::commit() {
+  if (fd_ == STDOUT_FILENO) {
+    committed_ = true;
+    return;
+  }
+  int err = 0;  // first errno seen
+  if (!temp_.empty() && ::fsync(fd_) != 0) err = errno;
+  if (::close(fd_) != 0 && err == 0) err = errno;
+  fd_ = -1;
+  if (err == 0 && !temp_.empty()) {  // mkstemp makes 0600; give the file the usual permissions
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    ::chmod(temp_.c_str(), 0666 & ~mask);
+    // Without --force the rename itself refuses to replace a file that appeared meanwhile.
+    const int r = force_ ? std::rename(temp_.c_str(), path_.c_str())
+                         : ::renameat2(AT_FDCWD, temp_.c_str(), AT_FDCWD, path_.c_str(), RENAME_NOREPLACE);
+    if (r != 0) err = errno;
+  }
+  if (err == EEXIST) fail(kOutputFailed, path_ + ": already exists; not overwritten (use -f)");
+  if (err != 0) fail(kOutputFailed, path_ + ": cannot write: " + std::strerror(err));
+  committed_ = true;
+  unregister_temp(slot_);
+}
+
+void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs, const Globals& g) {
+  std::vector<FileId> ids;
+  for (const std::string& in : inputs)
+    if (auto id = input_id(in)) ids.push_back(*id);
+  std::map<std::string, size_t> seen;  // output path in lower case -> input index
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    std::string key = outputs[i];
+    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (auto [it, fresh] = seen.emplace(key, i); !fresh)
+      fail(kOutputFailed, inputs[it->second] + " and " + inputs[i] + " would both be written to " + outputs[i] +
+                              (outputs[it->second] != outputs[i] ? " (or " + outputs[it->second] + ": the same file where case is ignored)" : "") +
+                              "; rename one of them");
+    struct stat st;
+    if (::stat(outputs[i].c_str(), &st) == 0) {
+      if (contains(ids, regular_id(st)))
+        fail(kOutputFailed, outputs[i] + ": is an input; an input is never overwritten, even with -f");
+      if (S_ISDIR(st.st_mode)) fail(kOutputFailed, outputs[i] + ": is a directory");
+      if (!g.force) fail(kOutputFailed, outputs[i] + ": already exists; not overwritten (use -f)");
+    }
+    // Every directory on the way must be a directory, or not exist yet (it is then created),
+    // and the deepest existing one writable.
+    for (fs::path dir = parent_of(outputs[i]);;) {
+      if (::stat(dir.c_str(), &st) == 0) {
+        if (!S_ISDIR(st.st_mode)) fail(kOutputFailed, outputs[i] + ": " + dir.string() + " is not a directory");
+        if (::access(dir.c_str(), W_OK | X_OK) != 0)
+          fail(kOutputFailed, outputs[i] + ": cannot create files in " + dir.string() + ": " + std::strerror(errno));
+        break;
+      }
+      if (errno == ENOTDIR) fail(kOutputFailed, outputs[i] + ": " + dir.string() + " is not a directory");
+      if (errno != ENOENT) break;  // left to the write itself to report
+      const fs::path up = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+      if (up == dir) break;
+      dir = up;
+    }
+  }
+}
+
+}  // namespace keyanim::cli

@@ -1,0 +1,92 @@
+// Inputs and outputs of the commands, opened and checked before any work is done. An output is
+// never an input (same device and inode, through hard links and symlinks, standard input and
+// output included), never replaces an existing file without --force, and is written to a
+// temporary file beside its target that is renamed over it only once complete: a failure or an
+// interrupt leaves no partial output.
+#pragma once
+#include <sys/types.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli.h"
+
+namespace keyanim::cli {
+
+// On SIGINT/SIGTERM/SIGHUP/SIGPIPE: remove the temporary outputs being written, then die.
+void install_interrupt_cleanup();
+
+struct FileId {
+  dev_t dev = 0;
+  ino_t ino = 0;
+  bool operator==(const FileId&) const = default;
+};
+// The identity of a regular file ("-": standard input), following symlinks; nothing for
+// anything else (a device, a pipe, a missing file), which cannot be lost by writing to it.
+std::optional<FileId> input_id(const std::string& path);
+
+// What a command reads; the first bytes decide, before the rest is read.
+enum class Kind { bvh, kanim, either };
+
+class Input {
+ public:
+  // Opens `path` ("-": standard input): exit 2 if it cannot be opened or is a directory, 6 if
+  // it is a regular file larger than --max-input, 4 if standard output is this very file.
+  Input(const std::string& path, const Globals& g);
+  ~Input();
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
+  const std::string& path() const { return path_; }
+  std::optional<FileId> id() const { return id_; }
+  // The whole content. Stops early with exit 2 when the first bytes cannot start a `kind` file
+  // (e.g. /dev/zero, a binary file), and with exit 6 past --max-input bytes.
+  std::vector<uint8_t> read(Kind kind);
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::optional<FileId> id_;
+  uint64_t max_bytes_ = 0;
+  uint64_t size_hint_ = 0;  // a regular file's size when opened
+};
+
+// Convenience: opens and reads at once, for commands that write no file.
+std::vector<uint8_t> read_input(const std::string& path, Kind kind, const Globals& g);
+offline::Motion load_bvh(const std::string& path, const Globals& g);
+
+class Output {
+ public:
+  // Checks and opens `path` ("-": standard output) now, before the work: exit 4 if it exists
+  // (without --force), is a directory, is one of `inputs`, or its directory is missing or not
+  // writable; binary data is not sent to a terminal without --force. A regular file is written
+  // to a new temporary file beside it; an existing device or pipe is written in place.
+  Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs);
+  ~Output();  // without commit(): the temporary file is removed
+  Output(const Output&) = delete;
+  Output& operator=(const Output&) = delete;
+  const std::string& path() const { return path_; }
+  void write(std::string_view data);  // exit 4 on an I/O error (e.g. a full disk)
+  // Complete: the temporary file is renamed over the target (exit 4 if that fails).
+  void commit();
+
+ private:
+  std::string path_, temp_;
+  int fd_ = -1;
+  int slot_ = -1;  // in the interrupt cleanup list
+  bool force_ = false;
+  bool committed_ = false;
+};
+
+// The identities of these inputs that are regular files.
+std::vector<FileId> ids_of(const std::vector<const Input*>& inputs);
+
+// Before a run over many inputs: refuses (exit 4) outputs that two inputs would share (paths
+// equal ignoring ASCII case, as on case-insensitive file systems), outputs that are inputs,
+// existing outputs without --force, outputs in the way of a directory, and an output
+// directory that is not one. `inputs[i]` is written to `outputs[i]`.
+void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs, const Globals& g);
+
+}  // namespace keyanim::cli
