@@ -6,7 +6,7 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
-  g++ cmake make pkg-config libzstd-dev zlib1g-dev nlohmann-json3-dev doctest-dev >/dev/null
+  g++ cmake make pkg-config libzstd-dev zlib1g-dev nlohmann-json3-dev doctest-dev python3 >/dev/null
 # For scripts/sanitize.sh's fuzz step: clang with libFuzzer (optional; skipped if unavailable).
 $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null 2>&1 ||
   $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >/dev/null 2>&1 ||

@@ -48,6 +48,7 @@ Args::Args(const std::vector<std::string>& argv, const std::set<std::string>& va
     if (const size_t eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
       name = a.substr(0, eq), value = a.substr(eq + 1), has_inline = true;
     }
+    if (name == "--output" && valued.count("-o")) name = "-o";  // one option, two spellings: the last wins
     if (valued.count(name)) {
       if (!has_inline) {
         if (i + 1 >= argv.size()) fail(kUsage, "option " + name + " needs a value");

@@ -57,6 +57,7 @@ struct Globals {
 class Args {
  public:
   // `valued`: options that take a value (e.g. "-o", "--error"); `flags`: options that do not.
+  // "--output" is stored as "-o". An option given twice keeps its last value.
   Args(const std::vector<std::string>& argv, const std::set<std::string>& valued,
        const std::set<std::string>& flags);
   const std::vector<std::string>& positional() const { return positional_; }

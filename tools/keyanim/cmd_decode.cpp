@@ -24,7 +24,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
   const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames"}, {});
   if (args.positional().size() != 1) fail(kUsage, "decode takes one input file");
   const std::string in = args.positional()[0];
-  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  std::string out = args.get("-o").value_or("");
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".bvh");
 
   offline::ResampleOptions opt;

@@ -140,7 +140,7 @@ int cmd_encode(const Argv& argv, Globals& g) {
   if (args.positional().size() != 1) fail(kUsage, "encode takes one input file or directory");
   offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];
-  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  std::string out = args.get("-o").value_or("");
   const bool json = args.has("--json");
 
   std::error_code ec;

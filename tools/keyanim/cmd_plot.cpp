@@ -46,7 +46,7 @@ int cmd_plot(const Argv& argv, Globals& g) {
   const offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];
 
-  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  std::string out = args.get("-o").value_or("");
   if (out.empty()) {
     const size_t colon = spec->rfind(':');
     out = in == "-" ? "-"

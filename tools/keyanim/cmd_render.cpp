@@ -85,7 +85,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   const uint32_t frame = frame_option.value_or(poses.frame_count() / 2);
   if (frame >= poses.frame_count())
     fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(poses.frame_count() - 1) + ")");
-  std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  std::string out = args.get("-o").value_or("");
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, "") + "-frame" + std::to_string(frame) + ".svg";
   Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}));
 
