@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "escape.h"
 #include "figures.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
@@ -114,6 +115,32 @@ TEST_CASE("svg numbers are short fixed point") {
   CHECK(svg::compact(12.5) == "12.5");
   CHECK(svg::escape("a<b & \"c\">") == "a&lt;b &amp; &quot;c&quot;&gt;");
   CHECK(svg::attr("class", "x\"y") == " class=\"x&quot;y\"");
+  // What XML cannot hold becomes visible escapes (expected strings written by hand).
+  CHECK(svg::escape("<\xff\x1b>") == "&lt;\\xff\\x1b&gt;");
+  CHECK(svg::escape("\xef\xbf\xbe") == "\\ufffe");  // U+FFFE is not an XML character
+}
+
+TEST_CASE("printable keeps UTF-8 text and escapes what could act on a terminal") {
+  using cli::printable;
+  CHECK(printable("Hips h\xc3\xbc" "fte \xe6\xad\xa9") == "Hips h\xc3\xbc" "fte \xe6\xad\xa9");  // ü, 歩
+  CHECK(printable("a\x1b[31mb") == "a\\x1b[31mb");
+  CHECK(printable("x\ny\tz\x7f") == "x\\x0ay\\x09z\\x7f");
+  CHECK(printable("\xc2\x9b") == "\\u009b");                 // C1 CSI
+  CHECK(printable("\xe2\x80\xae" "evil") == "\\u202e" "evil");      // right-to-left override
+  CHECK(printable("\xff\xfe") == "\\xff\\xfe");             // not UTF-8
+  CHECK(printable("\xc0\xaf") == "\\xc0\\xaf");             // overlong '/'
+  CHECK(printable("\xed\xa0\x80") == "\\xed\\xa0\\x80");     // a surrogate
+  CHECK(printable("\xe2\x80") == "\\xe2\\x80");             // cut short
+  CHECK(printable("\xf4\x90\x80\x80") == "\\xf4\\x90\\x80\\x80");  // above U+10FFFF
+  CHECK(printable("\xf0\x9f\x98\x80") == "\xf0\x9f\x98\x80");   // U+1F600 stays
+}
+
+TEST_CASE("json_text is dump() for UTF-8 and keeps other bytes as \\udcHH") {
+  const nlohmann::json ok = {{"name", "h\xc3\xbc" "fte \"q\" \\ \n\x01"}, {"n", 1.5}, {"list", {1, 2, nullptr, true}}, {"o", {{"a", "b"}}}};
+  CHECK(cli::json_text(ok) == ok.dump());
+  const nlohmann::json bad = {{"j", "r\xff\x1b[31m\xe2\x80"}};
+  CHECK(cli::json_text(bad) == "{\"j\":\"r\\udcff\\u001b[31m\\udce2\\udc80\"}");
+  CHECK_THROWS(bad.dump());  // what the tool used to do
 }
 
 TEST_CASE("svg ticks use 1 2 5 steps") {
