@@ -281,6 +281,9 @@ preflight)
   expect_rc 4 "$K" -f encode late.bvh -o adir
   grep -q 'is a directory' "$T/.stderr" || die "a directory output is not named: $(cat "$T/.stderr")"
   expect_rc 4 "$K" encode late.bvh -o afile/x.kanim
+  ln -s nowhere dangling.kanim                # a symbolic link to nothing is still in the way
+  expect_rc 4 "$K" encode late.bvh -o dangling.kanim
+  [ -L dangling.kanim ] || die "a dangling symbolic link was replaced without -f"
   [ "$(cat exists.kanim)" = precious ] && [ "$(cat afile)" = file ] || die "a file in the way changed"
   "$K" -q encode "$WALK" -o w.kanim || die "encode"
   printf 'x' >>w.kanim          # damaged: decode would fail with 2 once it reads it

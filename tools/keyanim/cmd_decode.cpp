@@ -57,7 +57,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
     decoder.frame(i, row);
     writer.frame(row.data());
   }
-  writer.finish();
+  if (!writer.finish()) fail(kInternal, "decode wrote a frame count other than the one it declared");
   output.commit();
   if (g.verbosity > 0 && out != "-")
     std::cerr << printable(in + " -> " + out) << ": " << decoder.frame_count() << " frames at " << decoder.frame_time() << " s\n";

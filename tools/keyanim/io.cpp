@@ -137,6 +137,43 @@ fs::path parent_of(const std::string& path) {
   return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
 
+enum class Target { absent, file, device };
+
+// What is at an output path, after the checks every output gets (exit 4): it is not an input,
+// not a directory, and not an existing file or symbolic link unless --force.
+Target check_target(const std::string& path, const std::vector<FileId>& inputs, bool force) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) {
+    if (::lstat(path.c_str(), &st) == 0 && !force)
+      fail(kOutputFailed, path + ": already exists (a symbolic link); not overwritten (use -f)");
+    return Target::absent;
+  }
+  if (contains(inputs, regular_id(st)))
+    fail(kOutputFailed, path + ": is an input; an input is never overwritten, even with -f");
+  if (S_ISDIR(st.st_mode)) fail(kOutputFailed, path + ": is a directory");
+  if (!force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
+  return S_ISREG(st.st_mode) ? Target::file : Target::device;
+}
+
+// Every directory on the way to `output` must be a directory, or not exist yet (a directory run
+// creates it), and the deepest existing one must be writable.
+void check_directories(const std::string& output) {
+  struct stat st;
+  for (fs::path dir = parent_of(output);;) {
+    if (::stat(dir.c_str(), &st) == 0) {
+      if (!S_ISDIR(st.st_mode)) fail(kOutputFailed, output + ": " + dir.string() + " is not a directory");
+      if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        fail(kOutputFailed, output + ": cannot create files in " + dir.string() + ": " + std::strerror(errno));
+      return;
+    }
+    if (errno == ENOTDIR) fail(kOutputFailed, output + ": " + dir.string() + " is not a directory");
+    if (errno != ENOENT) return;  // left to the write itself to report
+    const fs::path up = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+    if (up == dir) return;
+    dir = up;
+  }
+}
+
 }  // namespace
 
 void install_interrupt_cleanup() {
@@ -215,18 +252,11 @@ Output::Output(const std::string& path, bool binary, const Globals& g, const std
     fd_ = STDOUT_FILENO;
     return;
   }
-  struct stat st;
-  if (::stat(path.c_str(), &st) == 0) {
-    if (contains(inputs, regular_id(st)))
-      fail(kOutputFailed, path + ": is an input; an input is never overwritten, even with -f");
-    if (S_ISDIR(st.st_mode)) fail(kOutputFailed, path + ": is a directory");
-    if (!g.force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
-    // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
-    if (!S_ISREG(st.st_mode)) {
-      fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-      if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
-      return;
-    }
+  // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
+  if (check_target(path, inputs, g.force) == Target::device) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
+    return;
   }
   // A temporary file beside the target, renamed over it only once complete.
   const fs::path target(path);
@@ -296,28 +326,8 @@ void check_outputs(const std::vector<std::string>& inputs, const std::vector<std
       fail(kOutputFailed, inputs[it->second] + " and " + inputs[i] + " would both be written to " + outputs[i] +
                               (outputs[it->second] != outputs[i] ? " (or " + outputs[it->second] + ": the same file where case is ignored)" : "") +
                               "; rename one of them");
-    struct stat st;
-    if (::stat(outputs[i].c_str(), &st) == 0) {
-      if (contains(ids, regular_id(st)))
-        fail(kOutputFailed, outputs[i] + ": is an input; an input is never overwritten, even with -f");
-      if (S_ISDIR(st.st_mode)) fail(kOutputFailed, outputs[i] + ": is a directory");
-      if (!g.force) fail(kOutputFailed, outputs[i] + ": already exists; not overwritten (use -f)");
-    }
-    // Every directory on the way must be a directory, or not exist yet (it is then created),
-    // and the deepest existing one writable.
-    for (fs::path dir = parent_of(outputs[i]);;) {
-      if (::stat(dir.c_str(), &st) == 0) {
-        if (!S_ISDIR(st.st_mode)) fail(kOutputFailed, outputs[i] + ": " + dir.string() + " is not a directory");
-        if (::access(dir.c_str(), W_OK | X_OK) != 0)
-          fail(kOutputFailed, outputs[i] + ": cannot create files in " + dir.string() + ": " + std::strerror(errno));
-        break;
-      }
-      if (errno == ENOTDIR) fail(kOutputFailed, outputs[i] + ": " + dir.string() + " is not a directory");
-      if (errno != ENOENT) break;  // left to the write itself to report
-      const fs::path up = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-      if (up == dir) break;
-      dir = up;
-    }
+    check_target(outputs[i], ids, g.force);
+    check_directories(outputs[i]);
   }
 }
 
