@@ -13,9 +13,9 @@
 # "asan": the binary is built with AddressSanitizer, so address-space limits (ulimit -v) are
 # left out.
 set -uo pipefail
+README=$(realpath "$(dirname "${BASH_SOURCE[0]}")/../../README.md")
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 ASAN=${4:-}
-README="$(dirname "${BASH_SOURCE[0]}")/../../README.md"
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
 
 sums() { sha256sum "$@" 2>/dev/null; }
@@ -208,6 +208,14 @@ limits)
     bytes=$( (ulimit -v 60000; "$K" decode w.kanim --fps 24000 -o - | wc -c) ) || die "a long decode within 60 MB"
     [ "$bytes" -gt 50000000 ] || die "the long decode wrote only $bytes bytes"
   fi
+  # A small .kanim that declares many keys (they compress to almost nothing) is bounded by
+  # --max-values too.
+  "$PY" -c 'import sys; n = 200000; sys.stdout.write("HIERARCHY\nROOT r\n{\n OFFSET 0 0 0\n CHANNELS 1 Xposition\n End Site\n {\n  OFFSET 1 0 0\n }\n}\nMOTION\nFrames: %d\nFrame Time: 0.01\n" % n + "0\n1\n" * (n // 2))' >alt.bvh
+  expect_rc 0 "$K" encode alt.bvh -o alt.kanim --keys uniform:1
+  [ "$(stat -c %s alt.kanim)" -lt 10000 ] || die "the dense clip did not compress as expected"
+  expect_rc 6 "$K" --max-values 100K info alt.kanim
+  grep -q -- '--max-values' "$T/.stderr" || die "the refusal does not say how to raise the limit: $(cat "$T/.stderr")"
+  expect_rc 0 "$K" info alt.kanim
   # Deep skeletons: the BVH text stays linear in the depth (capped indentation) and reads back.
   chain_bvh deep.bvh 3000
   expect_rc 0 "$K" encode deep.bvh -o deep.kanim --keys uniform:1
@@ -334,6 +342,7 @@ exit_table)
   expect_rc 5 "$K" verify w.kanim --against "$WALK" --max-error 0.0001%
   expect_rc 6 "$K" --max-input 1K info w.kanim
   expect_rc 6 "$K" decode w.kanim --fps 1e6 -o big.bvh
+  expect_rc 6 "$K" --max-values 1K info w.kanim                       # 12085 keys
   if [ "$ASAN" != asan ]; then  # out of memory is 6 too (not "malformed input")
     oom=0
     for kb in 12000 16000 20000 24000; do

@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -24,8 +25,8 @@ const char* const kExitCodeTable =
     "  4  output cannot be written: exists (without -f), is an input, would also be another\n"
     "     input's output, is a directory, its directory is missing or read-only, disk full\n"
     "  5  a requested check failed (verify --max-error)\n"
-    "  6  a limit was reached: input over --max-input, decode over --max-values, a .kanim over\n"
-    "     the loader's limits, out of memory\n"
+    "  6  a limit was reached: input over --max-input, a decode or a .kanim's keys over\n"
+    "     --max-values, a .kanim over the loader's other limits, out of memory\n"
     "  7  internal error: a bug in keyanim (please report it)\n";
 
 void fail(int code, const std::string& message) { throw Failure{code, message}; }
@@ -146,17 +147,20 @@ offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_
   return m;
 }
 
-Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes) {
+Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g) {
   Clip clip;
   ErrorInfo info;
-  const Status s = Clip::load(bytes, clip, &info);
+  DecodeLimits limits;  // a few compressed bytes can declare many keys: --max-values bounds them too
+  limits.max_keys = std::min(limits.max_keys, g.limits.max_values);
+  const Status s = Clip::load(bytes, clip, &info, limits);
   if (s != Status::ok) {
     char where[64];
     std::snprintf(where, sizeof where, "offset %llu (0x%llX)", static_cast<unsigned long long>(info.byte_offset),
                   static_cast<unsigned long long>(info.byte_offset));
     const int code = s == Status::unsupported_version ? kUnsupported : s == Status::limit_exceeded ? kLimit : kBadInput;
     fail(code, path + ": section " + (info.section.empty() ? "?" : info.section) + ", " + where + ": " +
-                   status_string(s) + ": " + info.detail);
+                   status_string(s) + ": " + info.detail +
+                   (s == Status::limit_exceeded ? " (keys are limited by --max-values; the loader's other limits are fixed)" : ""));
   }
   return clip;
 }

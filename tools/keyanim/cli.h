@@ -43,7 +43,8 @@ Failure failure_of(const std::exception& e);
 // What keyanim takes from untrusted input at most (README, "Untrusted input").
 struct Limits {
   uint64_t max_input_bytes = uint64_t(1) << 30;  // --max-input: bytes of one input file
-  uint64_t max_values = uint64_t(1) << 28;       // --max-values: frames x channels made by a decode
+  uint64_t max_values = uint64_t(1) << 28;       // --max-values: frames x channels made by a decode,
+                                                 // and keys held by a loaded .kanim
 };
 
 struct Globals {
@@ -84,9 +85,9 @@ void check_values(uint64_t frames, uint64_t channels, const std::string& what, c
 bool looks_like_kanim(const std::vector<uint8_t>& bytes);
 // BVH text -> motion, or exit 2 naming file:line:column. Warnings go to stderr unless quiet.
 offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);
-// .kanim bytes -> clip, or exit 2 (3 for an unsupported version, 6 over the loader's limits)
-// naming section and offset.
-Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes);
+// .kanim bytes -> clip, or exit 2 (3 for an unsupported version, 6 over the loader's limits or
+// more keys than --max-values) naming section and offset.
+Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);
 
 // "walk.bvh" + ".kanim" -> "walk.kanim"
 std::string swap_extension(const std::string& path, const std::string& ext);

@@ -41,7 +41,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
 
   Input input(in, g);
   Output output(out, false, g, ids_of({&input}));
-  const Clip clip = load_kanim(in, input.read(Kind::kanim));
+  const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
   if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())
     fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
   offline::FrameDecoder decoder;

@@ -106,8 +106,12 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
   const std::vector<std::string> files = expand_inputs({in});
   if (files.empty()) fail(kBadInput, in + ": no .bvh files found");
   std::vector<std::string> targets;
-  for (const std::string& f : files)
-    targets.push_back(swap_extension((std::filesystem::path(out) / std::filesystem::relative(f, in)).string(), ".kanim"));
+  for (const std::string& f : files) {
+    std::error_code ec;
+    const std::filesystem::path rel = std::filesystem::relative(f, in, ec);
+    if (ec) fail(kBadInput, f + ": " + ec.message());
+    targets.push_back(swap_extension((std::filesystem::path(out) / rel).string(), ".kanim"));
+  }
   check_outputs(files, targets, g);
   std::vector<Encoded> results(files.size());
   Globals quiet = g;

@@ -69,7 +69,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
     const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, runs[r].zstd_level);
     const double encode_ms = ms(te);
     const auto td = Clock::now();
-    const Clip clip = load_kanim(path + " (encoded)", bytes);
+    const Clip clip = load_kanim(path + " (encoded)", bytes, g);
     offline::Motion back;
     if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, path + ": " + error);
     const double decode_ms = ms(td);

@@ -68,7 +68,7 @@ int cmd_info(const Argv& argv, Globals& g) {
     j["frames"] = m.frame_count;
     j["frame_time"] = m.frame_time;
   } else {
-    const Clip clip = load_kanim(in, bytes);
+    const Clip clip = load_kanim(in, bytes, g);
     j = {{"file", in},
          {"format", "kanim"},
          {"version", std::to_string(clip.version_major()) + "." + std::to_string(clip.version_minor())},

@@ -39,7 +39,7 @@ struct Poses {
 
   Poses(const std::string& path, Input& input, const Globals& g) {
     const std::vector<uint8_t> bytes = input.read(Kind::either);
-    if (looks_like_kanim(bytes)) clip = load_kanim(path, bytes);
+    if (looks_like_kanim(bytes)) clip = load_kanim(path, bytes, g);
     else motion = load_bvh_bytes(path, bytes, g);
   }
   uint32_t frame_count() const { return clip ? clip->frame_count() : motion->frame_count; }

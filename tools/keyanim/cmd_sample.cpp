@@ -25,7 +25,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   if (args.has("--frame") == args.has("--time")) fail(kUsage, "sample needs exactly one of --frame and --time");
   const std::string in = args.positional()[0];
   const double frame = args.get_double("--frame", 0.0), time = args.get_double("--time", 0.0);
-  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g));
+  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g), g);
   // A clip without frames, or without a frame time for --time, cannot give what was asked.
   if (clip.frame_count() == 0) fail(kBadInput, in + ": the clip has no frames to sample");
   if (args.has("--time") && !(clip.frame_time() > 0.0)) fail(kBadInput, in + ": the clip has no frame time; use --frame");

@@ -33,7 +33,7 @@ int cmd_verify(const Argv& argv, Globals& g) {
   if (args.get("--against") == "-" && in == "-") fail(kUsage, "only one input can be standard input");
   std::optional<offline::EncodeSettings> limit;  // parsed before any work
   if (auto text = args.get("--max-error")) parse_tolerance(*text, limit.emplace(), "--max-error");
-  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g));
+  const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g), g);
   nlohmann::json j = {{"file", in}, {"valid", true}};
   bool ok = true;
   std::string why;

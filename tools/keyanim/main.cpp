@@ -44,7 +44,8 @@ const char* const kGlobalHelp =
     "                        to a terminal\n"
     "  --max-input SIZE      largest input file read, in bytes (K, M, G: powers of 1024);\n"
     "                        default 1G\n"
-    "  --max-values N        most values (frames x channels) a decode may make; default 256M\n";
+    "  --max-values N        most values (frames x channels) a decode may make, and most keys\n"
+    "                        a loaded .kanim may hold; default 256M\n";
 
 void print_main_help() {
   std::cout << "keyanim " KEYANIM_VERSION_STRING " - skeletal motion as keyframes, rebuilt by Cardinal splines\n"
