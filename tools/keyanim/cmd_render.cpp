@@ -72,7 +72,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   const std::string in = args.positional()[0];
   const auto against = args.get("--against");
   if (against && *against == "-" && in == "-") fail(kUsage, "only one input can be standard input");
-  const std::optional<uint32_t> frame_option = args.has("--frame") ? std::optional(args.get_uint("--frame", 0)) : std::nullopt;
+  const uint32_t frame_option = args.get_uint("--frame", 0);  // parsed before any work
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
@@ -82,7 +82,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   if (against) other.emplace(*against, g);
   const Poses poses(in, input, g);
   if (poses.frame_count() == 0) fail(kBadInput, in + ": no frames to render");
-  const uint32_t frame = frame_option.value_or(poses.frame_count() / 2);
+  const uint32_t frame = args.has("--frame") ? frame_option : poses.frame_count() / 2;
   if (frame >= poses.frame_count())
     fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(poses.frame_count() - 1) + ")");
   std::string out = args.get("-o").value_or("");
