@@ -1,0 +1,261 @@
+// The .kanim decoder, written from spec/FORMAT.md alone: container (sections 1-3), the CLIP,
+// SKEL, CHAN, KTIM and NOTE sections (4), the checks of sections 5-8, in the order section 7
+// recommends. Versions 3.0 and, by Appendix E, 1.0 and 2.0. Key values: kval.js;
+// sampling (Appendix A): sample.js.
+import { fail, KanimError } from './errors.js';
+import { SectionReader } from './reader.js';
+import { crc32 } from './crc32.js';
+import { decompressSection, isZstdFailure } from './zstd.js';
+import { decodeKeyValues } from './kval.js';
+
+export { KanimError };
+
+const SIGNATURE = [0x89, 0x4b, 0x41, 0x4e, 0x0d, 0x0a, 0x1a, 0x0a];
+const CRITICAL = ['CLIP', 'SKEL', 'CHAN', 'KTIM', 'KVAL'];
+export const CHANNEL_TYPES = ['Xposition', 'Yposition', 'Zposition', 'Xrotation', 'Yrotation', 'Zrotation'];
+export const MAX_FRAMES_V3 = 2 ** 24;
+
+// keyanim's defaults (spec section 8).
+export const DEFAULT_LIMITS = Object.freeze({
+  nodes: 65536, channels: 262144, frames: 2 ** 24, keys: 268435456, rawBytes: 2 ** 30,
+});
+
+// True when the bytes start like a .kanim file (the signature), for telling it from a BVH.
+export function looksLikeKanim(bytes) {
+  return bytes.length >= 8 && SIGNATURE.every((b, i) => bytes[i] === b);
+}
+
+// Decodes and validates a whole file. Returns the clip (see makeClip) or throws KanimError.
+export function decodeKanim(input, limits = DEFAULT_LIMITS) {
+  const bytes = input instanceof Uint8Array ? input : new Uint8Array(input);
+  const { version, sections } = readContainer(bytes, limits);
+  const clip = makeClip(version, bytes.length, sections);
+  for (const s of sections) {
+    const parse = SECTION_PARSERS[s.tag];
+    if (!parse || (s.tag === 'NOTE' && !s.ancillary)) continue;
+    parse(new SectionReader(s.tag, sectionContent(bytes, s), s.offset, s.compressed), clip, limits);
+  }
+  return clip;
+}
+
+function makeClip(version, fileBytes, sections) {
+  return {
+    version, fileBytes,
+    sections: sections.map(({ tag, compressed, storedSize, rawSize }) => ({ tag, compressed, storedSize, rawSize })),
+    frameCount: 0, frameTime: 0, tangentRule: 0, nodeCount: 0, channelCount: 0, keyCount: 0,
+    nodes: [], channels: [], notes: '',
+  };
+}
+
+// --- Signature, header, section table, file length, raw-size limit, checksum ---------------
+
+function readContainer(bytes, limits) {
+  for (let i = 0; i < 8; ++i) {
+    if (i >= bytes.length) fail('truncated', 'signature', bytes.length, 'the file ends inside the signature');
+    if (bytes[i] !== SIGNATURE[i]) fail('bad_signature', 'signature', i, 'not a .kanim file (wrong signature)');
+  }
+  if (bytes.length < 24) fail('truncated', 'header', bytes.length, 'the file ends inside the header');
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const major = view.getUint16(8, true), minor = view.getUint16(10, true);
+  if (major < 1 || major > 3) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 3)`);
+  if (view.getUint32(12, true) & 0xffff) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  const count = view.getUint32(16, true);
+  if (view.getUint32(20, true) !== 0) fail('reserved_bits_set', 'header', 20, 'Header_Reserved is not 0');
+  const tableEnd = 24 + 24 * count;
+  if (bytes.length < tableEnd) fail('truncated', 'section table', bytes.length, `the file ends inside the table of ${count} sections`);
+
+  const sections = readTable(bytes, view, count);
+  checkLength(bytes.length, tableEnd, sections);
+  let raw = 0n;
+  for (const s of sections) if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
+  if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', 24, `the sections decode to ${raw} bytes, above the limit of ${limits.rawBytes}`);
+  const stored = view.getUint32(bytes.length - 4, true), computed = crc32(bytes.subarray(0, bytes.length - 4));
+  if (stored !== computed) fail('checksum_mismatch', 'checksum', bytes.length - 4, `CRC-32 is 0x${hex8(computed)}, the file says 0x${hex8(stored)}`);
+  return { version: { major, minor }, sections };
+}
+
+const hex8 = (v) => v.toString(16).padStart(8, '0');
+
+function tagName(b) {
+  const printable = [...b].every((c) => c >= 0x20 && c < 0x7f);
+  return printable ? String.fromCharCode(...b) : [...b].map((c) => c.toString(16).padStart(2, '0')).join(' ');
+}
+
+// Section 3.1 and rules 3.2.2 to 3.2.4, entry by entry.
+function readTable(bytes, view, count) {
+  const sections = [];
+  let nextCritical = 0, notes = 0;
+  let offset = 24n + 24n * BigInt(count);
+  for (let i = 0; i < count; ++i) {
+    const e = 24 + 24 * i;
+    const tag = tagName(bytes.subarray(e, e + 4));
+    const where = `section ${i} (${tag})`;
+    const flags = view.getUint32(e + 4, true);
+    if (flags & 0xfffc) fail('reserved_bits_set', 'section table', e + 4, `${where}: reserved Section_Flags bits are set`);
+    const compressed = (flags & 1) !== 0, ancillary = (flags & 2) !== 0;
+    const critical = CRITICAL.indexOf(tag);
+    if (critical >= 0) {
+      if (ancillary) fail('corrupt', 'section table', e + 4, `${where}: ${tag} must be critical (Ancillary clear)`);
+      if (critical !== nextCritical) fail('corrupt', 'section table', e, `${where}: ${nextCritical < CRITICAL.length ? `expected ${CRITICAL[nextCritical]}` : `${tag} again`} (the critical sections come once each, in the order ${CRITICAL.join(', ')})`);
+      ++nextCritical;
+    } else if (tag === 'NOTE') {
+      if (!ancillary) fail('corrupt', 'section table', e + 4, `${where}: NOTE must be ancillary`);
+      if (++notes > 1) fail('corrupt', 'section table', e, `${where}: a second NOTE section`);
+    } else if (!ancillary) {
+      fail('reserved_bits_set', 'section table', e, `${where}: unknown critical section`);
+    }
+    const storedSize = view.getBigUint64(e + 8, true), rawSize = view.getBigUint64(e + 16, true);
+    if (!compressed && rawSize !== storedSize) fail('corrupt', 'section table', e + 16, `${where}: Raw_Size ${rawSize} differs from Stored_Size ${storedSize} in an uncompressed section`);
+    sections.push({ tag, compressed, ancillary, storedSize, rawSize, offset });
+    offset += storedSize;
+  }
+  if (nextCritical < CRITICAL.length) fail('corrupt', 'section table', 24, `no ${CRITICAL[nextCritical]} section`);
+  return sections;
+}
+
+// Rule 3.2.1: the file is exactly 28 + 24 n + the stored sizes (BigInt: no overflow).
+function checkLength(length, tableEnd, sections) {
+  const want = sections.reduce((sum, s) => sum + s.storedSize, BigInt(tableEnd) + 4n);
+  if (BigInt(length) < want) fail('truncated', 'section table', length, `the file holds ${length} bytes, the table declares ${want}`);
+  if (BigInt(length) > want) fail('trailing_bytes', 'checksum', Number(want), `${BigInt(length) - want} bytes follow the checksum`);
+  for (const s of sections) s.offset = Number(s.offset);
+}
+
+function sectionContent(bytes, s) {
+  const stored = bytes.subarray(s.offset, s.offset + Number(s.storedSize));
+  if (!s.compressed) return stored;
+  try {
+    return decompressSection(stored, Number(s.rawSize));
+  } catch (e) {
+    if (isZstdFailure(e)) fail('zstd_error', `section ${s.tag}`, s.offset, e.message);
+    throw e;
+  }
+}
+
+// --- Sections -------------------------------------------------------------------------------
+
+function parseClip(r, clip, limits) {
+  if (r.length !== 32) r.fail('corrupt', 0, `CLIP holds ${r.length} bytes, not 32`);
+  const v3 = clip.version.major === 3;
+  const frames = r.u32();
+  if (v3 && frames > MAX_FRAMES_V3) r.fail('corrupt', 0, `Frame_Count ${frames} is above 2^24`);
+  if (frames > limits.frames) r.fail('limit_exceeded', 0, `Frame_Count ${frames} is above the limit of ${limits.frames}`);
+  const nodes = r.u32();
+  if (nodes > limits.nodes) r.fail('limit_exceeded', 4, `Node_Count ${nodes} is above the limit of ${limits.nodes}`);
+  const channels = r.u32();
+  if (channels > limits.channels) r.fail('limit_exceeded', 8, `Channel_Count ${channels} is above the limit of ${limits.channels}`);
+  const rule = r.u8();
+  if (rule > 1) r.fail('reserved_bits_set', 12, `reserved Tangent_Rule ${rule}`);
+  if (r.u8() !== 0) r.fail('reserved_bits_set', 13, 'reserved Clip_Flags bits are set');
+  if (r.u16() !== 0) r.fail('reserved_bits_set', 14, 'Clip_Reserved is not 0');
+  const frameTime = r.f64();
+  if (!Number.isFinite(frameTime) || frameTime < 0) r.fail('corrupt', 16, `Frame_Time ${frameTime} is not finite and >= 0`);
+  if (frames > 1 && !(frameTime > 0)) r.fail('corrupt', 16, `Frame_Time is 0 with ${frames} frames`);
+  const keys = r.u64();
+  if (keys > BigInt(channels) * BigInt(frames)) r.fail('corrupt', 24, `Key_Count ${keys} is above Channel_Count x Frame_Count`);
+  if (keys > BigInt(limits.keys)) r.fail('limit_exceeded', 24, `Key_Count ${keys} is above the limit of ${limits.keys}`);
+  Object.assign(clip, { frameCount: frames, nodeCount: nodes, channelCount: channels, tangentRule: rule, frameTime, keyCount: Number(keys) });
+}
+
+const NODE_MIN_BYTES = 34;  // Name_Length, Parent, Offset, Node_Flags, Node_Channel_Count
+
+function parseSkel(r, clip) {
+  const n = clip.nodeCount;
+  if (n * NODE_MIN_BYTES > r.length) r.fail('corrupt', 0, `SKEL is too short for ${n} nodes`);
+  const names = new TextDecoder('utf-8');  // names are shown, never compared as bytes here
+  let channelSum = 0;
+  for (let i = 0; i < n; ++i) {
+    const start = r.pos, what = `node ${i}`;
+    const nameLength = r.u32(`${what}: Name_Length`);
+    if (nameLength > r.remaining) r.fail('corrupt', start, `${what}: the name runs past the end of SKEL`);
+    const name = names.decode(r.take(nameLength));
+    const parentAt = r.pos, parent = r.i32(`${what}: Parent`);
+    if (parent < -1 || parent >= i) r.fail('corrupt', parentAt, `${what}: Parent ${parent} is not -1 or an earlier node`);
+    if (parent >= 0 && clip.nodes[parent].endSite) r.fail('corrupt', parentAt, `${what}: its parent ${parent} is an End Site`);
+    const offset = [];
+    for (let k = 0; k < 3; ++k) {
+      const at = r.pos, v = r.f64(`${what}: Offset`);
+      if (!Number.isFinite(v)) r.fail('corrupt', at, `${what}: Offset ${'XYZ'[k]} is not finite`);
+      offset.push(v);
+    }
+    const flagsAt = r.pos, flags = r.u8(`${what}: Node_Flags`);
+    if (flags & 0xfe) r.fail('reserved_bits_set', flagsAt, `${what}: reserved Node_Flags bits are set`);
+    const endSite = (flags & 1) !== 0;
+    if (endSite && parent < 0) r.fail('corrupt', flagsAt, `${what}: an End Site without a parent`);
+    const countAt = r.pos, count = r.u8(`${what}: Node_Channel_Count`);
+    if (count > 6) r.fail('corrupt', countAt, `${what}: ${count} channels (at most 6)`);
+    if (endSite && count > 0) r.fail('corrupt', countAt, `${what}: an End Site with channels`);
+    const channels = [];
+    for (let k = 0; k < count; ++k) {
+      const at = r.pos, type = r.u8(`${what}: Channel_Types`);
+      if (type > 5) r.fail('reserved_bits_set', at, `${what}: reserved channel type ${type}`);
+      channels.push(type);
+    }
+    clip.nodes.push({ name, parent, offset, endSite, channels, firstChannel: channelSum });
+    channelSum += count;
+  }
+  r.expectEnd(`the ${n} node records`);
+  if (channelSum !== clip.channelCount) r.fail('corrupt', 0, `the nodes have ${channelSum} channels, CLIP says ${clip.channelCount}`);
+}
+
+function parseChan(r, clip) {
+  const c = clip.channelCount, major = clip.version.major;
+  const perChannel = { 1: 17, 2: 18, 3: 19 }[major];
+  if (r.length !== perChannel * c) r.fail('corrupt', 0, `CHAN holds ${r.length} bytes, not ${perChannel} x ${c}`);
+  const channels = [];
+  clip.nodes.forEach((node, n) => node.channels.forEach((type) => channels.push({ node: n, type })));
+  const each = (fn) => channels.forEach((ch, i) => fn(ch, i, r.pos));
+  each((ch, i, at) => {
+    ch.interp = r.u8();
+    if (ch.interp > 1) r.fail('reserved_bits_set', at, `channel ${i}: reserved Interpolation ${ch.interp}`);
+  });
+  each((ch, i, at) => {
+    ch.tension = r.f32();
+    if (!(ch.tension >= -1 && ch.tension <= 1)) r.fail('corrupt', at, `channel ${i}: Tension ${ch.tension} is not in [-1, 1]`);
+  });
+  each((ch, i, at) => {
+    ch.step = r.f64();
+    if (!(Number.isFinite(ch.step) && ch.step > 0)) r.fail('corrupt', at, `channel ${i}: Step ${ch.step} is not finite and > 0`);
+  });
+  let keys = 0;
+  each((ch, i, at) => {
+    ch.keyCount = r.u32();
+    if (ch.keyCount > clip.frameCount) r.fail('corrupt', at, `channel ${i}: Key_Count ${ch.keyCount} is above Frame_Count ${clip.frameCount}`);
+    keys += ch.keyCount;
+  });
+  each((ch, i, at) => {
+    ch.valueCoding = major >= 2 ? r.u8() : 0;
+    if (ch.valueCoding > 1) r.fail('reserved_bits_set', at, `channel ${i}: reserved Value_Coding ${ch.valueCoding}`);
+  });
+  if (major >= 3) {
+    each((ch, i, at) => {
+      ch.residualBytes = r.u8();
+      if (ch.residualBytes > 8) r.fail('corrupt', at, `channel ${i}: Residual_Bytes ${ch.residualBytes} (at most 8)`);
+      if (ch.keyCount === 0 && ch.residualBytes !== 0) r.fail('corrupt', at, `channel ${i}: Residual_Bytes ${ch.residualBytes} for a channel without keys`);
+    });
+  }
+  if (keys !== clip.keyCount) r.fail('corrupt', 13 * c, `the channels have ${keys} keys, CLIP says ${clip.keyCount}`);
+  clip.channels = channels;
+}
+
+function parseKtim(r, clip) {
+  if (clip.keyCount > r.length) r.fail('corrupt', 0, `KTIM is too short for ${clip.keyCount} keys`);
+  clip.channels.forEach((ch, c) => {
+    const frames = new Int32Array(ch.keyCount);
+    let prev = -1;
+    for (let i = 0; i < ch.keyCount; ++i) {
+      const at = r.pos, gap = r.varint(5, 32, `channel ${c} key ${i}`);
+      const frame = prev + 1 + gap;  // exact: below 2^33
+      if (frame >= clip.frameCount) r.fail('corrupt', at, `channel ${c} key ${i}: frame ${frame} is not below Frame_Count ${clip.frameCount}`);
+      frames[i] = prev = frame;
+    }
+    ch.keyFrames = frames;
+  });
+  r.expectEnd(`the ${clip.keyCount} key frames`);
+}
+
+function parseNote(r, clip) {
+  clip.notes = new TextDecoder('utf-8').decode(r.bytes);
+}
+
+const SECTION_PARSERS = { CLIP: parseClip, SKEL: parseSkel, CHAN: parseChan, KTIM: parseKtim, KVAL: decodeKeyValues, NOTE: parseNote };
