@@ -25,6 +25,13 @@ export function looksLikeKanim(bytes) {
   return bytes.length >= 8 && SIGNATURE.every((b, i) => bytes[i] === b);
 }
 
+// How keyanim's tools name node i: its name, or "End Site of PARENT" for an unnamed End Site.
+export function nodeLabel(nodes, i) {
+  const n = nodes[i];
+  if (!n.endSite || n.name !== '') return n.name;
+  return n.parent >= 0 ? `End Site of ${nodes[n.parent].name}` : 'End Site';
+}
+
 // Decodes and validates a whole file. Returns the clip (see makeClip) or throws KanimError.
 export function decodeKanim(input, limits = DEFAULT_LIMITS) {
   const bytes = input instanceof Uint8Array ? input : new Uint8Array(input);
@@ -32,7 +39,7 @@ export function decodeKanim(input, limits = DEFAULT_LIMITS) {
   const clip = makeClip(version, bytes.length, sections);
   for (const s of sections) {
     const parse = SECTION_PARSERS[s.tag];
-    if (!parse || (s.tag === 'NOTE' && !s.ancillary)) continue;
+    if (!parse) continue;  // an ancillary section of a later minor version
     parse(new SectionReader(s.tag, sectionContent(bytes, s), s.offset, s.compressed), clip, limits);
   }
   return clip;

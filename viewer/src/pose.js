@@ -1,0 +1,72 @@
+// Forward kinematics as spec/FORMAT.md Appendix B: a node's local rotation is the product of
+// its rotation channels in channel order (intrinsic, degrees, right-handed); its translation is
+// its Offset with each position channel replacing its component; p = p_parent + R_parent p_local,
+// R = R_parent R_local. In binary64. Works on the node lists of kanim.js and bvh.js alike.
+
+const DEG = Math.PI / 180;
+
+// 3x3 row-major: a x b into out (out may not alias a or b).
+function mul(a, b, out) {
+  for (let r = 0; r < 3; ++r)
+    for (let c = 0; c < 3; ++c) out[3 * r + c] = a[3 * r] * b[c] + a[3 * r + 1] * b[3 + c] + a[3 * r + 2] * b[6 + c];
+}
+
+function axisRotation(axis, degrees, out) {
+  const c = Math.cos(degrees * DEG), s = Math.sin(degrees * DEG);
+  if (axis === 0) out.set([1, 0, 0, 0, c, -s, 0, s, c]);
+  else if (axis === 1) out.set([c, 0, s, 0, 1, 0, -s, 0, c]);
+  else out.set([c, -s, 0, s, c, 0, 0, 0, 1]);
+}
+
+// World positions of every node for one frame: `values` holds every channel (frame column
+// order); `out` gets x, y, z per node. Returns out.
+export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.length)) {
+  const rot = new Float64Array(9 * nodes.length);
+  const local = new Float64Array(9), axis = new Float64Array(9), tmp = new Float64Array(9);
+  for (let i = 0; i < nodes.length; ++i) {
+    const node = nodes[i];
+    const t = node.offset.slice();
+    local.set([1, 0, 0, 0, 1, 0, 0, 0, 1]);
+    node.channels.forEach((type, k) => {
+      const v = values[node.firstChannel + k];
+      if (type < 3) { t[type] = v; return; }
+      axisRotation(type - 3, v, axis);
+      mul(local, axis, tmp);
+      local.set(tmp);
+    });
+    const R = rot.subarray(9 * i, 9 * i + 9);
+    if (node.parent < 0) {
+      R.set(local);
+      out.set(t, 3 * i);
+      continue;
+    }
+    const P = rot.subarray(9 * node.parent, 9 * node.parent + 9), p = 3 * node.parent;
+    mul(P, local, R);
+    for (let r = 0; r < 3; ++r) out[3 * i + r] = out[p + r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
+  }
+  return out;
+}
+
+// The largest side of the box around the rest pose (every channel 0 but positions keep the
+// Offset): the length scale of the skeleton, for tolerances, the camera and the grid.
+export function skeletonSize(nodes) {
+  const rest = nodes.map((n) => ({ ...n, channels: [] }));
+  const p = worldPositions(rest, []);
+  let size = 0;
+  for (let axis = 0; axis < 3; ++axis) {
+    let lo = Infinity, hi = -Infinity;
+    for (let i = axis; i < p.length; i += 3) { lo = Math.min(lo, p[i]); hi = Math.max(hi, p[i]); }
+    size = Math.max(size, hi - lo);
+  }
+  return size;
+}
+
+// The largest distance between two position arrays of the same skeleton, and the node.
+export function largestDistance(a, b) {
+  let worst = 0, node = 0;
+  for (let i = 0; i < a.length; i += 3) {
+    const d = Math.hypot(a[i] - b[i], a[i + 1] - b[i + 1], a[i + 2] - b[i + 2]);
+    if (d > worst) { worst = d; node = i / 3; }
+  }
+  return { distance: worst, node };
+}
