@@ -74,8 +74,10 @@ function readContainer(bytes, limits) {
   const sections = readTable(bytes, view, count);
   checkLength(bytes.length, tableEnd, sections);
   let raw = 0n;
-  for (const s of sections) if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
-  if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', 24, `the sections decode to ${raw} bytes, above the limit of ${limits.rawBytes}`);
+  for (const s of sections) {
+    if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
+    if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `the sections decode to ${raw} bytes or more, above the limit of ${limits.rawBytes}`);
+  }
   const stored = view.getUint32(bytes.length - 4, true), computed = crc32(bytes.subarray(0, bytes.length - 4));
   if (stored !== computed) fail('checksum_mismatch', 'checksum', bytes.length - 4, `CRC-32 is 0x${hex8(computed)}, the file says 0x${hex8(stored)}`);
   return { version: { major, minor }, sections };
@@ -112,9 +114,10 @@ function readTable(bytes, view, count) {
       fail('reserved_bits_set', 'section table', e, `${where}: unknown critical section`);
     }
     const storedSize = view.getBigUint64(e + 8, true), rawSize = view.getBigUint64(e + 16, true);
-    if (!compressed && rawSize !== storedSize) fail('corrupt', 'section table', e + 16, `${where}: Raw_Size ${rawSize} differs from Stored_Size ${storedSize} in an uncompressed section`);
-    sections.push({ tag, compressed, ancillary, storedSize, rawSize, offset });
+    if (!compressed && rawSize !== storedSize) fail('corrupt', 'section table', e + 8, `${where}: Raw_Size ${rawSize} differs from Stored_Size ${storedSize} in an uncompressed section`);
+    sections.push({ tag, compressed, ancillary, storedSize, rawSize, offset, entry: e });
     offset += storedSize;
+    if (offset + 4n > BigInt(bytes.length)) fail('truncated', 'section table', bytes.length, `${where}: the file ends before the section's declared end`);
   }
   if (nextCritical < CRITICAL.length) fail('corrupt', 'section table', 24, `no ${CRITICAL[nextCritical]} section`);
   return sections;
@@ -159,8 +162,8 @@ function parseClip(r, clip, limits) {
   if (!Number.isFinite(frameTime) || frameTime < 0) r.fail('corrupt', 16, `Frame_Time ${frameTime} is not finite and >= 0`);
   if (frames > 1 && !(frameTime > 0)) r.fail('corrupt', 16, `Frame_Time is 0 with ${frames} frames`);
   const keys = r.u64();
-  if (keys > BigInt(channels) * BigInt(frames)) r.fail('corrupt', 24, `Key_Count ${keys} is above Channel_Count x Frame_Count`);
   if (keys > BigInt(limits.keys)) r.fail('limit_exceeded', 24, `Key_Count ${keys} is above the limit of ${limits.keys}`);
+  if (keys > BigInt(channels) * BigInt(frames)) r.fail('corrupt', 24, `Key_Count ${keys} is above Channel_Count x Frame_Count`);
   Object.assign(clip, { frameCount: frames, nodeCount: nodes, channelCount: channels, tangentRule: rule, frameTime, keyCount: Number(keys) });
 }
 
@@ -188,7 +191,7 @@ function parseSkel(r, clip) {
     const flagsAt = r.pos, flags = r.u8(`${what}: Node_Flags`);
     if (flags & 0xfe) r.fail('reserved_bits_set', flagsAt, `${what}: reserved Node_Flags bits are set`);
     const endSite = (flags & 1) !== 0;
-    if (endSite && parent < 0) r.fail('corrupt', flagsAt, `${what}: an End Site without a parent`);
+    if (endSite && parent < 0) r.fail('corrupt', parentAt, `${what}: an End Site without a parent`);
     const countAt = r.pos, count = r.u8(`${what}: Node_Channel_Count`);
     if (count > 6) r.fail('corrupt', countAt, `${what}: ${count} channels (at most 6)`);
     if (endSite && count > 0) r.fail('corrupt', countAt, `${what}: an End Site with channels`);

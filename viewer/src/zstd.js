@@ -68,8 +68,11 @@ function walkBlocks(frame, start, blockMax) {
 }
 
 // The frame again, with a single-segment header that declares `size` in 4 bytes: fzstd then
-// allocates the content size, never a window the header may claim. Same blocks, same meaning
-// for a valid frame (a single segment's window is the whole content).
+// allocates that, never a window the original header may claim. Same blocks, same meaning for a
+// valid frame (a single segment's window is the whole content). The caller declares one block
+// more than Raw_Size: fzstd decodes a block into a buffer of at most the declared size and drops
+// what does not fit without a word, so a damaged block that decodes to too much must find room
+// to show it.
 function singleSegmentFrame(frame, blocksStart, size, checksum) {
   const out = new Uint8Array(9 + frame.length - blocksStart);
   out.set([0x28, 0xb5, 0x2f, 0xfd, 0xa0 | (checksum << 2)]);
@@ -98,7 +101,7 @@ export function decompressSection(frame, rawSize) {
     filled += chunk.length;
   });
   try {
-    sink.push(singleSegmentFrame(frame, h.blocksStart, rawSize, h.checksum), true);
+    sink.push(singleSegmentFrame(frame, h.blocksStart, rawSize + BLOCK_MAX, h.checksum), true);
   } catch (e) {
     if (isZstdFailure(e)) throw e;
     bad(`zstd cannot decompress the frame (${e.message})`);
