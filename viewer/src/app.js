@@ -1,0 +1,216 @@
+// The page: opening files (picker, drag and drop, embedded by `keyanim view`), playback, and
+// the panels. Decoding is kanim.js/sample.js; drawing is view3d.js and curves.js.
+import { decodeKanim, looksLikeKanim, nodeLabel } from './kanim.js';
+import { samplePose } from './sample.js';
+import { parseBvh } from './bvh.js';
+import { worldPositions, skeletonSize, largestDistance } from './pose.js';
+import { View3D } from './view3d.js';
+import { CurvePanel } from './curves.js';
+import { clipFacts, noteLines } from './facts.js';
+
+const $ = (id) => document.getElementById(id);
+
+export class App {
+  constructor() {
+    this.view = new View3D($('view'));
+    this.curves = new CurvePanel($('curve'), $('curve-channel'), $('curve-span'));
+    Object.assign(this, { clip: null, original: null, originalName: '', position: 0, clock: 0, playing: false, lastTick: 0 });
+    this.bindControls();
+    this.bindFiles();
+  }
+
+  // --- Opening files ---------------------------------------------------------------------
+
+  loadClip(bytes, name) {
+    try {
+      const clip = decodeKanim(bytes);
+      if (clip.frameCount === 0) throw new Error('the clip has no frames');
+      this.clip = clip;
+      this.clipName = name;
+      this.values = new Float32Array(clip.channelCount);
+      this.size = skeletonSize(clip.nodes) || 1;
+      if (this.original && !this.matches(this.original)) this.dropOriginal(`${this.originalName} does not have the skeleton of ${name}: not shown`);
+      this.setup();
+      this.message(`${name}: ${clip.frameCount} frames, ${clip.keyCount} keys`);
+    } catch (e) {
+      this.error(`${name}: ${e.message}`);
+      throw e;
+    }
+  }
+
+  loadOriginal(text, name) {
+    try {
+      const original = parseBvh(text);
+      original.name = name;
+      original.bytes = new TextEncoder().encode(text).length;
+      if (this.clip && !this.matches(original)) throw new Error(`its skeleton differs from the clip's (${original.nodes.length} nodes, ${original.channelCount} channels; the clip: ${this.clip.nodes.length}, ${this.clip.channelCount})`);
+      this.original = original;
+      this.originalName = name;
+      if (this.clip) this.setup();
+      this.message(`${name}: ${original.frameCount} frames${original.warnings.length ? ` (${original.warnings.join('; ')})` : ''}`);
+    } catch (e) {
+      this.error(`${name}: ${e.message}`);
+      throw e;
+    }
+  }
+
+  // The same hierarchy and channel layout: nodes, parents and channel types, in order.
+  matches(o) {
+    const a = this.clip.nodes, b = o.nodes;
+    return a.length === b.length && a.every((n, i) => n.parent === b[i].parent && n.endSite === b[i].endSite && n.channels.join() === b[i].channels.join());
+  }
+
+  dropOriginal(why) {
+    this.original = null;
+    this.originalName = '';
+    this.message(why);
+  }
+
+  async openFiles(files) {
+    for (const file of [...files].sort((a) => (a.name.endsWith('.bvh') ? 1 : -1))) {  // clip first
+      const bytes = new Uint8Array(await file.arrayBuffer());
+      try {
+        if (looksLikeKanim(bytes)) this.loadClip(bytes, file.name);
+        else this.loadOriginal(new TextDecoder().decode(bytes), file.name);
+      } catch { /* shown by error() */ }
+    }
+  }
+
+  // A clip (and original) written into the page by `keyanim view`.
+  loadEmbedded() {
+    const clip = document.getElementById('keyanim-embedded-clip');
+    if (!clip) return false;
+    const decode = (el) => Uint8Array.from(atob(el.textContent.trim()), (c) => c.charCodeAt(0));
+    const original = document.getElementById('keyanim-embedded-original');
+    try {
+      this.loadClip(decode(clip), clip.dataset.name);
+      if (original) this.loadOriginal(new TextDecoder().decode(decode(original)), original.dataset.name);
+    } catch { /* shown by error() */ }
+    return true;
+  }
+
+  // --- Scene and panels --------------------------------------------------------------------
+
+  setup() {
+    const clip = this.clip;
+    this.position = 0;
+    this.clock = 0;
+    this.worstOverClip = this.original ? this.compareAllFrames() : null;
+    const first = worldPositions(clip.nodes, samplePose(clip, 0, this.values));
+    this.view.setSkeleton(clip.nodes, this.size, first, !!this.original);
+    this.curves.setClip(clip, this.original);
+    $('slider').max = String(clip.frameCount - 1);
+    $('facts').replaceChildren(...clipFacts(clip, this.original).flatMap(([k, v]) => [el('dt', k), el('dd', v)]));
+    $('notes').textContent = noteLines(clip).join('\n') || '(none)';
+    $('compare').hidden = !this.original;
+    document.body.classList.add('loaded');
+    this.show(0);
+  }
+
+  // Largest distance between original and decoded over every source frame both have.
+  compareAllFrames() {
+    const frames = Math.min(this.clip.frameCount, this.original.frameCount);
+    let worst = { distance: 0, node: 0, frame: 0 };
+    for (let f = 0; f < frames; ++f) {
+      const d = largestDistance(this.decodedAt(f), this.originalAt(f));
+      if (d.distance > worst.distance) worst = { ...d, frame: f };
+    }
+    return worst;
+  }
+
+  decodedAt(x) { return worldPositions(this.clip.nodes, samplePose(this.clip, x, this.values)); }
+
+  // The original at frame position x: its nearest frame (a BVH has nothing in between).
+  originalAt(x) {
+    const o = this.original, f = Math.min(o.frameCount - 1, Math.max(0, Math.round(x)));
+    return worldPositions(o.nodes, o.frames.subarray(f * o.channelCount, (f + 1) * o.channelCount));
+  }
+
+  // Draws frame position x everywhere.
+  show(x) {
+    const clip = this.clip;
+    this.position = x;
+    const decoded = this.decodedAt(x);
+    let original = null, worst = null;
+    if (this.original) {
+      // Compared at the nearest source frame: the original has nothing in between.
+      const f = Math.min(Math.max(Math.round(x), 0), this.original.frameCount - 1);
+      original = this.originalAt(f);
+      worst = largestDistance(f === x ? decoded : this.decodedAt(f), original);
+      const w = this.worstOverClip;
+      $('compare-frame').textContent = `${fmtLength(worst.distance)} at ${nodeLabel(clip.nodes, worst.node)} (${pct(worst.distance, this.size)} of the skeleton size${f === x ? '' : `; at frame ${f}, the nearest`})`;
+      $('compare-clip').textContent = `${fmtLength(w.distance)} at ${nodeLabel(clip.nodes, w.node)}, frame ${w.frame} (${pct(w.distance, this.size)})`;
+    }
+    this.view.setPoses(decoded, $('show-original').checked ? original : null, worst ? worst.node : -1);
+    this.view.showOriginal($('show-original').checked);
+    $('slider').value = String(x);
+    const t = clip.frameTime * x;
+    $('frame-label').textContent = `frame ${fmtFrame(x)} / ${clip.frameCount - 1} · ${t.toFixed(3)} s`;
+    this.curves.setPosition(x);
+  }
+
+  // --- Playback ----------------------------------------------------------------------------
+
+  // The frame position at clip time `seconds`: on the grid of the playback rate (source rate:
+  // whole frames; 24/30/60/120 fps: in-betweens from the curves).
+  positionAt(seconds) {
+    const clip = this.clip;
+    if (!(clip.frameTime > 0)) return 0;
+    const rate = $('rate').value === 'source' ? 1 / clip.frameTime : Number($('rate').value);
+    return Math.floor(seconds * rate + 1e-9) / rate / clip.frameTime;
+  }
+
+  tick(now) {
+    if (!this.playing) return;
+    const dt = this.lastTick ? (now - this.lastTick) / 1000 : 0;
+    this.lastTick = now;
+    const clip = this.clip, duration = (clip.frameCount - 1) * clip.frameTime;
+    this.clock += dt * Number($('speed').value);
+    if (this.clock > duration) this.clock = duration > 0 ? this.clock % duration : 0;
+    const x = this.positionAt(this.clock);
+    if (x !== this.position) this.show(x);
+    requestAnimationFrame((t) => this.tick(t));
+  }
+
+  setPlaying(on) {
+    this.playing = on && !!this.clip && this.clip.frameCount > 1;
+    $('play').textContent = this.playing ? 'Pause' : 'Play';
+    this.lastTick = 0;
+    if (this.playing) requestAnimationFrame((t) => this.tick(t));
+  }
+
+  bindControls() {
+    $('play').addEventListener('click', () => this.setPlaying(!this.playing));
+    $('slider').addEventListener('input', () => {
+      if (!this.clip) return;
+      this.clock = Number($('slider').value) * this.clip.frameTime;
+      this.show(this.positionAt(this.clock));
+    });
+    $('rate').addEventListener('change', () => this.clip && this.show(this.positionAt(this.clock)));
+    $('show-original').addEventListener('change', () => this.clip && this.show(this.position));
+    $('follow').addEventListener('change', () => { this.view.follow = $('follow').checked; });
+    document.addEventListener('keydown', (e) => {
+      if (e.target.tagName === 'SELECT' || e.target.tagName === 'INPUT' && e.target.type !== 'range') return;
+      if (e.code === 'Space') { e.preventDefault(); this.setPlaying(!this.playing); }
+    });
+  }
+
+  bindFiles() {
+    $('open').addEventListener('change', (e) => this.openFiles(e.target.files));
+    window.addEventListener('dragover', (e) => { e.preventDefault(); document.body.classList.add('dragging'); });
+    window.addEventListener('dragleave', () => document.body.classList.remove('dragging'));
+    window.addEventListener('drop', (e) => {
+      e.preventDefault();
+      document.body.classList.remove('dragging');
+      this.openFiles(e.dataTransfer.files);
+    });
+  }
+
+  message(text) { const m = $('message'); m.textContent = text; m.className = ''; }
+  error(text) { const m = $('message'); m.textContent = text; m.className = 'error'; console.warn(text); }
+}
+
+function el(tag, text) { const e = document.createElement(tag); e.textContent = text; return e; }
+const fmtLength = (d) => Number(d.toPrecision(3)).toString();
+const pct = (d, size) => `${Number(((100 * d) / size).toPrecision(2))}%`;
+const fmtFrame = (x) => (Number.isInteger(x) ? String(x) : x.toFixed(2));

@@ -1,0 +1,26 @@
+// File facts: what the clip holds and what it costs, as label/value rows for the side panel.
+const fmt = (v, digits = 4) => Number(v.toPrecision(digits)).toLocaleString('en-US');
+const bytes = (n) => (n < 10240 ? `${n} B` : n < 10485760 ? `${fmt(n / 1024, 3)} KiB` : `${fmt(n / 1048576, 3)} MiB`);
+
+// clip: from decodeKanim; original: { name, bytes } of the BVH text, when loaded.
+export function clipFacts(clip, original) {
+  const joints = clip.nodes.filter((n) => !n.endSite).length;
+  const rawF32 = clip.frameCount * clip.channelCount * 4;
+  const rows = [
+    ['format', `.kanim ${clip.version.major}.${clip.version.minor}`],
+    ['frames', `${clip.frameCount}`],
+    ['fps', clip.frameTime > 0 ? fmt(1 / clip.frameTime, 5) : '-'],
+    ['duration', clip.frameTime > 0 ? `${fmt(Math.max(0, clip.frameCount - 1) * clip.frameTime, 4)} s` : '-'],
+    ['joints', `${joints} (+${clip.nodes.length - joints} End Sites)`],
+    ['channels', `${clip.channelCount}`],
+    ['keys', `${clip.keyCount} (${fmt((100 * clip.keyCount) / Math.max(1, rawF32 / 4), 3)}% of all values)`],
+    ['tangent rule', clip.tangentRule === 1 ? 'step_adjusted' : 'uniform'],
+    ['bytes', bytes(clip.fileBytes)],
+    ['ratio', `${fmt(rawF32 / clip.fileBytes, 3)}x raw float32`],
+  ];
+  if (original) rows.push(['original', `${original.name}: ${bytes(original.bytes)} (${fmt(original.bytes / clip.fileBytes, 3)}x)`]);
+  return rows;
+}
+
+// Encoder notes: key=value lines (spec 4.6), informative only.
+export const noteLines = (clip) => clip.notes.split('\n').filter((l) => l.trim() !== '');
