@@ -11,4 +11,11 @@ $SUDO apt-get install -y -qq --no-install-recommends \
 $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null 2>&1 ||
   $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >/dev/null 2>&1 ||
   echo "keyanim: clang/libFuzzer not installed; the fuzz step of scripts/sanitize.sh will be skipped"
+# For the browser viewer (viewer/): node and npm to build it, chromium for its browser tests
+# (driven by puppeteer-core from npm, which never downloads a browser of its own). A machine
+# that already has node and npm (e.g. from another package source) keeps them.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+fi
+$SUDO apt-get install -y -qq --no-install-recommends chromium >/dev/null
 echo "keyanim: build dependencies installed"

@@ -17,6 +17,7 @@ int cmd_plot(const Argv& argv, Globals& g);
 int cmd_render(const Argv& argv, Globals& g);
 int cmd_eval(const Argv& argv, Globals& g);
 int cmd_verify(const Argv& argv, Globals& g);
+int cmd_view(const Argv& argv, Globals& g);
 
 extern const char* const kEncodeHelp;
 extern const char* const kDecodeHelp;
@@ -26,5 +27,6 @@ extern const char* const kPlotHelp;
 extern const char* const kRenderHelp;
 extern const char* const kEvalHelp;
 extern const char* const kVerifyHelp;
+extern const char* const kViewHelp;
 
 }  // namespace keyanim::cli

@@ -32,6 +32,7 @@ const Command kCommands[] = {
     {"render", cmd_render, &kRenderHelp, true, "SVG: one frame as a stick figure, front and side view"},
     {"eval", cmd_eval, &kEvalHelp, true, "compression against error for files and tolerances"},
     {"verify", cmd_verify, &kVerifyHelp, false, "check a .kanim, and its error against the original"},
+    {"view", cmd_view, &kViewHelp, false, "HTML page that plays a .kanim in the browser (3D skeleton)"},
 };
 
 const char* const kGlobalHelp =

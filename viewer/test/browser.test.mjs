@@ -1,0 +1,122 @@
+// The viewer in a real browser: Debian's chromium, headless, driven by puppeteer-core. The page
+// loads a corpus clip with no console error; sampleWorld agrees with `keyanim sample --world
+// --json` within 1e-4 of the skeleton size, at frames and in-betweens; a screenshot of the 3D
+// view shows both skeletons (pixels of each colour). The same for a page from `keyanim view`.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { pathToFileURL } from 'node:url';
+import { decodeKanim } from '../src/kanim.js';
+import { skeletonSize } from '../src/pose.js';
+import { decodePng } from './png.mjs';
+import { corpusDir, keyanimCli, viewerPage, sourceDir, exists } from './paths.mjs';
+
+const chromium = process.env.KEYANIM_CHROMIUM || '/usr/bin/chromium';
+// A corpus clip (CMU 02_01, a walk); without the corpus, the same take shipped in data/.
+const corpusClip = path.join(corpusDir, 'cmu/BvhToDeepMimic__02_01.bvh');
+const clipBvh = exists(corpusClip) ? corpusClip : path.join(sourceDir, 'data/cmu_02_01_walk.bvh');
+const skip = !exists(chromium) ? `no chromium at ${chromium}` : !exists(keyanimCli) ? `no keyanim CLI at ${keyanimCli}`
+  : !exists(viewerPage) ? `no built viewer page at ${viewerPage}` : false;
+const FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+  '--disable-component-update', '--disable-sync',
+  '--enable-unsafe-swiftshader'];  // WebGL in software: chromium warns that the implicit fallback is going away
+
+let browser, dir, kanim, clip;
+const cli = (...args) => execFileSync(keyanimCli, args, { encoding: 'utf8' });
+
+before(async () => {
+  if (skip) return;
+  dir = fs.mkdtempSync(path.join(os.tmpdir(), 'keyanim-viewer-browser-'));
+  kanim = path.join(dir, 'clip.kanim');
+  cli('encode', clipBvh, '-o', kanim, '-q');
+  clip = decodeKanim(fs.readFileSync(kanim));
+  const { default: puppeteer } = await import('puppeteer-core');
+  browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: [...FLAGS, `--user-data-dir=${path.join(dir, 'profile')}`] });
+});
+after(async () => {
+  await browser?.close();
+  if (dir) fs.rmSync(dir, { recursive: true, force: true });
+});
+
+// Opens a page; collects console errors and uncaught exceptions.
+async function open(url) {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1280, height: 800 });
+  const problems = [];
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console error: ${m.text()}`); });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('requestfailed', (r) => problems.push(`request failed: ${r.url()}`));
+  await page.goto(url, { waitUntil: 'load' });
+  await page.waitForFunction(() => window.keyanim !== undefined);
+  return { page, problems };
+}
+
+// Pixels of a screenshot for which is(r, g, b) holds.
+function count(png, is) {
+  let n = 0;
+  for (let i = 0; i < png.data.length; i += png.channels) if (is(png.data[i], png.data[i + 1], png.data[i + 2])) ++n;
+  return n;
+}
+// Lit and shaded, the figures' colours vary: orange is red over green over blue, blue the reverse.
+const isBackground = (r, g, b) => r === 0x1c && g === 0x1f && b === 0x26;
+const isOrange = (r, g, b) => r > g + 25 && g > b + 15 && r > 90;
+const isBlue = (r, g, b) => b > r + 50 && b > g + 10;
+
+async function expectSkeletonsDrawn(page, withOriginal, shotPath) {
+  const view = await page.$('#view');
+  const png = decodePng(Buffer.from(await view.screenshot(shotPath ? { path: shotPath } : {})));
+  const pixels = png.width * png.height, background = count(png, isBackground);
+  assert.ok(background > pixels * 0.3 && background < pixels * 0.995, `background ${background} of ${pixels} pixels: the view is blank or not drawn`);
+  const orange = count(png, isOrange), blue = count(png, isBlue);
+  assert.ok(orange > 300, `${orange} orange pixels: no decoded skeleton in the screenshot`);
+  if (withOriginal) assert.ok(blue > 100, `${blue} blue pixels: no original skeleton in the screenshot`);
+  else assert.ok(blue < 20, `${blue} blue pixels without an original`);
+}
+
+async function expectWorldAgrees(page) {
+  const size = skeletonSize(clip.nodes), F = clip.frameCount;
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), F);
+  for (const x of [0, 1, 0.5, 2.25, F / 3 + 0.37, F - 1.5, F - 1]) {
+    const got = await page.evaluate((p) => window.keyanim.sampleWorld(p), x);
+    const want = JSON.parse(cli('sample', kanim, '--frame', String(x), '--world', '--json')).joints;
+    assert.equal(got.length, want.length);
+    want.forEach((j, i) => {
+      const d = Math.hypot(got[i][0] - j.position[0], got[i][1] - j.position[1], got[i][2] - j.position[2]);
+      if (!(d <= 1e-4 * size)) assert.fail(`frame ${x}, node ${i} (${j.name}): ${got[i]} vs ${j.position}, off by ${d} (skeleton size ${size})`);
+    });
+  }
+}
+
+test('the page loads a corpus clip through window.keyanim.load, with no console error', { skip }, async () => {
+  const { page, problems } = await open(pathToFileURL(viewerPage).href);
+  const bytes = fs.readFileSync(kanim).toString('base64');
+  await page.evaluate((b) => window.keyanim.load(Uint8Array.from(atob(b), (c) => c.charCodeAt(0)).buffer, 'clip.kanim'), bytes);
+  await expectWorldAgrees(page);
+  await page.evaluate((x) => window.keyanim.show(x), clip.frameCount / 2 + 0.5);
+  await expectSkeletonsDrawn(page, false);
+  assert.match(await page.$eval('#facts', (e) => e.textContent), new RegExp(`frames${clip.frameCount}`));
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a page from `keyanim view --against` plays the clip with its original overlaid', { skip }, async () => {
+  const html = path.join(dir, 'view.html');
+  assert.equal(cli('view', kanim, '--against', clipBvh, '-o', html, '--no-open').trim(), html);
+  const { page, problems } = await open(pathToFileURL(html).href);
+  await expectWorldAgrees(page);
+  // The largest distance over the clip is the error the encoder measured (its notes say it).
+  const comparison = await page.evaluate(() => window.keyanim.comparison);
+  const reported = Number(/max_error=([0-9.eE+-]+)/.exec(clip.notes)?.[1]);
+  assert.ok(comparison && Math.abs(comparison.distance - reported) <= 1e-6 * skeletonSize(clip.nodes), `page: ${JSON.stringify(comparison)}, encoder: ${reported}`);
+  await page.evaluate(() => { document.getElementById('rate').value = '60'; window.keyanim.show(40.5); });
+  assert.match(await page.$eval('#compare-frame', (e) => e.textContent), /at .+ of the skeleton size/);
+  await expectSkeletonsDrawn(page, true, process.env.KEYANIM_SCREENSHOT);
+  await page.click('#play');
+  await new Promise((r) => setTimeout(r, 300));
+  assert.equal(await page.$eval('#play', (e) => e.textContent), 'Pause');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
