@@ -8,16 +8,18 @@ export const COLORS = { decoded: 0xf08c28, original: 0x3aa0ff, worst: 0xff3050 }
 // One drawn skeleton: an instanced sphere per node and an instanced cylinder per bone
 // (node -> parent), both of radius proportional to the skeleton size.
 class SkeletonFigure {
-  constructor(scene, nodes, color, radius) {
+  // onTop: drawn over everything else (the original, so that it shows through the decoded figure).
+  constructor(scene, nodes, color, radius, onTop = false) {
     this.nodes = nodes;
     this.radius = radius;
     this.bones = nodes.map((n, i) => [i, n.parent]).filter(([, p]) => p >= 0);
-    const material = new THREE.MeshLambertMaterial({ color });
+    const material = new THREE.MeshLambertMaterial({ color, depthTest: !onTop });
     this.joints = new THREE.InstancedMesh(new THREE.SphereGeometry(radius, 12, 8), material, nodes.length);
     const cylinder = new THREE.CylinderGeometry(1, 1, 1, 8).translate(0, 0.5, 0);  // spans y 0..1
     this.links = new THREE.InstancedMesh(cylinder, material, Math.max(1, this.bones.length));
     this.links.count = this.bones.length;
     this.joints.frustumCulled = this.links.frustumCulled = false;  // they move every frame
+    this.joints.renderOrder = this.links.renderOrder = onTop ? 1 : 0;
     scene.add(this.joints, this.links);
   }
 
@@ -80,9 +82,9 @@ export class View3D {
     for (const f of Object.values(this.figures)) f.dispose(this.scene);
     if (this.grid) { this.scene.remove(this.grid); this.grid.geometry.dispose(); }
     const radius = size * 0.012;
-    // The original inside the decoded figure: where they agree it shows as a blue core.
+    // The original thinner and on top: where the two agree it shows as a blue core.
     this.figures = { decoded: new SkeletonFigure(this.scene, nodes, COLORS.decoded, radius) };
-    if (withOriginal) this.figures.original = new SkeletonFigure(this.scene, nodes, COLORS.original, radius * 0.6);
+    if (withOriginal) this.figures.original = new SkeletonFigure(this.scene, nodes, COLORS.original, radius * 0.45, true);
     this.worst = this.worst ?? new THREE.Mesh(new THREE.SphereGeometry(1, 16, 12), new THREE.MeshBasicMaterial({ color: COLORS.worst, wireframe: true }));
     this.worst.scale.setScalar(radius * 2.2);
     this.worst.visible = false;
