@@ -67,7 +67,8 @@ export class App {
   }
 
   async openFiles(files) {
-    for (const file of [...files].sort((a) => (a.name.endsWith('.bvh') ? 1 : -1))) {  // clip first
+    const isBvh = (f) => (/\.bvh$/i.test(f.name) ? 1 : 0);
+    for (const file of [...files].sort((a, b) => isBvh(a) - isBvh(b))) {  // the clip first
       const bytes = new Uint8Array(await file.arrayBuffer());
       try {
         if (looksLikeKanim(bytes)) this.loadClip(bytes, file.name);

@@ -114,9 +114,34 @@ test('a page from `keyanim view --against` plays the clip with its original over
   await page.evaluate(() => { document.getElementById('rate').value = '60'; window.keyanim.show(40.5); });
   assert.match(await page.$eval('#compare-frame', (e) => e.textContent), /at .+ of the skeleton size/);
   await expectSkeletonsDrawn(page, true, process.env.KEYANIM_SCREENSHOT);
+  // Playing moves the slider.
+  const slider = () => page.$eval('#slider', (e) => Number(e.value));
+  const before = await slider();
   await page.click('#play');
-  await new Promise((r) => setTimeout(r, 300));
+  await page.waitForFunction((x) => Number(document.getElementById('slider').value) !== x, { timeout: 5000 }, before);
   assert.equal(await page.$eval('#play', (e) => e.textContent), 'Pause');
+  await page.click('#play');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('the file picker opens a clip and its original; a damaged file is reported in the page', { skip }, async () => {
+  const { page, problems } = await open(pathToFileURL(viewerPage).href);
+  const input = await page.$('#open');
+  await input.uploadFile(clipBvh, kanim);  // in either order: the clip is opened first
+  await page.waitForFunction(() => window.keyanim.comparison !== null, { timeout: 10000 });
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), clip.frameCount);
+  assert.match(await page.$eval('#facts', (e) => e.textContent), /original/);
+  await expectSkeletonsDrawn(page, true);
+
+  const damaged = path.join(dir, 'damaged.kanim');
+  const bytes = fs.readFileSync(kanim);
+  bytes[bytes.length - 1] ^= 1;
+  fs.writeFileSync(damaged, bytes);
+  await input.uploadFile(damaged);
+  await page.waitForFunction(() => document.getElementById('message').className === 'error');
+  assert.match(await page.$eval('#message', (e) => e.textContent), /^damaged\.kanim: checksum, offset \d+ \(0x[0-9a-f]+\): checksum_mismatch: /);
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), clip.frameCount, 'the clip shown before stays');
   assert.deepEqual(problems, []);
   await page.close();
 });

@@ -11,7 +11,7 @@ import { execFileSync } from 'node:child_process';
 import { decodeKanim, nodeLabel } from '../src/kanim.js';
 import { samplePose } from '../src/sample.js';
 import { parseBvh } from '../src/bvh.js';
-import { worldPositions, skeletonSize } from '../src/pose.js';
+import { worldPositions, skeletonSize, largestDistance } from '../src/pose.js';
 import { corpusDir, keyanimCli, exists, bvhFilesBelow } from './paths.mjs';
 
 const clips = bvhFilesBelow(corpusDir);
@@ -73,4 +73,26 @@ test('corpus clips: JS decoder = C++ decoder, bit for bit', { skip }, (t) => {
     ++checked;
   }
   assert.equal(checked, clips.length);
+});
+
+// The viewer's comparison (its BVH reader, forward kinematics and largest distance) over every
+// frame of every corpus clip gives the error the encoder measured and wrote in its notes.
+test('corpus clips: original against decoded in JS = the encoder\'s max_error', { skip }, (t) => {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'keyanim-viewer-error-'));
+  t.after(() => fs.rmSync(dir, { recursive: true, force: true }));
+  cli('encode', corpusDir, '-o', dir, '-q', '--error', '0.5%');
+  for (const bvh of clips) {
+    const label = path.relative(corpusDir, bvh);
+    const clip = decodeKanim(fs.readFileSync(path.join(dir, label).replace(/\.bvh$/, '.kanim')));
+    const original = parseBvh(fs.readFileSync(bvh, 'latin1'));
+    assert.equal(original.frameCount, clip.frameCount, label);
+    let worst = 0;
+    const values = new Float32Array(clip.channelCount), n = original.channelCount;
+    for (let f = 0; f < clip.frameCount; ++f) {
+      const d = largestDistance(worldPositions(clip.nodes, samplePose(clip, f, values)), worldPositions(original.nodes, original.frames.subarray(f * n, (f + 1) * n)));
+      worst = Math.max(worst, d.distance);
+    }
+    const reported = Number(/^max_error=(.*)$/m.exec(clip.notes)[1]);  // printed with 6 digits
+    assert.ok(Math.abs(worst - reported) <= 1e-5 * reported + 1e-12, `${label}: JS ${worst}, encoder ${reported}`);
+  }
 });
