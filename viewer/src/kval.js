@@ -15,13 +15,15 @@ export function decodeKeyValues(r, clip) {
   clip.channels.forEach((ch, c) => {
     const frames = ch.keyFrames, values = new Float32Array(ch.keyCount);
     let q1 = 0n, q2 = 0n;  // q_{i-1}, q_{i-2}
+    let channelAt = 0;  // where the channel's residuals start: keyanim reports a value there
     for (let i = 0; i < ch.keyCount; ++i) {
       const { residual, at } = next(ch);
+      if (i === 0) channelAt = at;
       if (abs(residual) > rBound) r.fail('corrupt', at, `channel ${c} key ${i}: residual ${residual} is above 2^${major === 1 ? 54 : 57}`);
       const q = predict(ch, i, q1, q2, frames) + residual;
       if (abs(q) > TWO53) r.fail('corrupt', at, `channel ${c} key ${i}: quantized value ${q} is above 2^53`);
       const v = Math.fround(Number(q) * ch.step);  // exact conversion, one binary64 rounding, then RN32
-      if (!Number.isFinite(v)) r.fail('corrupt', at, `channel ${c} key ${i}: value ${Number(q)} x ${ch.step} is not finite in binary32`);
+      if (!Number.isFinite(v)) r.fail('corrupt', channelAt, `channel ${c} key ${i}: value ${Number(q)} x ${ch.step} is not finite in binary32`);
       values[i] = v;
       q2 = q1;
       q1 = q;
