@@ -10,9 +10,12 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <fstream>
+#include <iterator>
 #include <optional>
 
 #include "commands.h"
+#include "io.h"
 #include "svg.h"  // escape(): the same escaping serves an HTML attribute
 
 extern char** environ;
@@ -67,14 +70,16 @@ std::string read_page() {
   for (const fs::path& p : page_candidates()) {
     std::error_code ec;
     if (fs::is_regular_file(p, ec)) {
-      const std::vector<uint8_t> bytes = read_input(p.string());
-      return std::string(bytes.begin(), bytes.end());
+      std::ifstream f(p, std::ios::binary);
+      std::string page((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+      if (!f.good() && !f.eof()) fail(kUnsupported, p.string() + ": cannot read the viewer page");
+      return page;
     }
-    searched += "\n  " + p.lexically_normal().string();
+    searched += (searched.empty() ? " " : ", ") + p.lexically_normal().string();
   }
-  fail(kUnsupported, "the viewer page is not installed (it is built when node and npm are found at configure time); looked for:" +
-                         (searched.empty() ? std::string("\n  (no candidates)") : searched) +
-                         "\nSet KEYANIM_VIEWER_PAGE to a built viewer/dist/index.html.");
+  fail(kUnsupported, "the viewer page is not installed (it is built when node and npm are found at configure time); looked for" +
+                         (searched.empty() ? std::string(" nothing") : searched) +
+                         "; set KEYANIM_VIEWER_PAGE to a built viewer/dist/index.html");
 }
 
 std::string embedded(const char* id, const std::string& path, const std::vector<uint8_t>& bytes) {
@@ -121,40 +126,46 @@ int cmd_view(const Argv& argv, Globals& g) {
   const Args args(argv, {"-o", "--output", "--against"}, {"--no-open"});
   if (args.positional().size() != 1) fail(kUsage, "view takes one .kanim file");
   const std::string in = args.positional()[0];
-  const std::vector<uint8_t> clip_bytes = read_input(in);
-  if (!looks_like_kanim(clip_bytes)) fail(kBadInput, in + ": not a .kanim file (bad signature)");
-  const Clip clip = load_kanim(in, clip_bytes);  // the page decodes it again; a bad file fails here, clearly
-  std::string embed = embedded("keyanim-embedded-clip", in, clip_bytes);
-  if (auto orig = args.get("--against")) {
-    const std::vector<uint8_t> bvh = read_input(*orig);
-    const offline::Motion m = load_bvh_bytes(*orig, bvh, g);
-    if (!same_hierarchy(m.skeleton, clip.skeleton()))
-      fail(kBadInput, *orig + ": its hierarchy or channels differ from " + in + "'s");
-    if (m.frame_count != clip.frame_count() && g.verbosity > 0)
-      std::cerr << "keyanim: warning: " << *orig << " has " << m.frame_count << " frames, " << in << " has "
-                << clip.frame_count() << "; the page compares the frames both have\n";
-    embed += embedded("keyanim-embedded-original", *orig, bvh);
-  }
-
-  std::string page = read_page();
-  const std::string marker = "<!-- keyanim:embed -->";
-  const size_t at = page.find(marker);
-  if (at == std::string::npos || page.find(marker, at + 1) != std::string::npos)
-    fail(kUnsupported, "the viewer page has no single embed marker; rebuild it");
-  page.replace(at, marker.size(), embed);
-
   std::optional<std::string> out = args.get("-o");
-  if (!out) out = args.get("--output");
   if (out && *out == "-") fail(kUsage, "view writes a file (its path is printed); use -o FILE.html");
+  const std::string page_template = read_page();  // before the work: a missing page is exit 3 at once
+
+  // Inputs and the output are opened and checked before anything is read.
+  Input clip_input(in, g);
+  std::optional<Input> orig_input;
+  if (auto orig = args.get("--against")) orig_input.emplace(*orig, g);
   Globals write = g;
   if (!out) {
     out = temporary_page(in);
     write.force = true;  // the empty file just made for it
   }
-  std::error_code ec;
-  for (const std::optional<std::string>& input : {std::optional<std::string>(in), args.get("--against")})
-    if (input && fs::equivalent(*input, *out, ec)) fail(kUsage, *out + ": is an input; not overwritten");
-  write_output(*out, page, false, write);
+  std::vector<const Input*> inputs = {&clip_input};
+  if (orig_input) inputs.push_back(&*orig_input);
+  Output output(*out, false, write, ids_of(inputs));
+
+  const std::vector<uint8_t> clip_bytes = clip_input.read(Kind::kanim);
+  const Clip clip = load_kanim(in, clip_bytes, g);  // the page decodes it again; a bad file fails here, clearly
+  std::string embed = embedded("keyanim-embedded-clip", in, clip_bytes);
+  if (orig_input) {
+    const std::string& orig = orig_input->path();
+    const std::vector<uint8_t> bvh = orig_input->read(Kind::bvh);
+    const offline::Motion m = load_bvh_bytes(orig, bvh, g);
+    if (!same_hierarchy(m.skeleton, clip.skeleton()))
+      fail(kBadInput, orig + ": its hierarchy or channels differ from " + in + "'s");
+    if (m.frame_count != clip.frame_count() && g.verbosity > 0)
+      std::cerr << "keyanim: warning: " << orig << " has " << m.frame_count << " frames, " << in << " has "
+                << clip.frame_count() << "; the page compares the frames both have\n";
+    embed += embedded("keyanim-embedded-original", orig, bvh);
+  }
+
+  std::string page = page_template;
+  const std::string marker = "<!-- keyanim:embed -->";
+  const size_t at = page.find(marker);
+  if (at == std::string::npos || page.find(marker, at + 1) != std::string::npos)
+    fail(kUnsupported, "the viewer page has no single embed marker; rebuild it");
+  page.replace(at, marker.size(), embed);
+  output.write(page);
+  output.commit();
   std::cout << *out << "\n";
   if (!args.has("--no-open")) open_in_browser(*out, g);
   return kOk;
