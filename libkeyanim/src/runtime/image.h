@@ -93,7 +93,6 @@ struct Image {
   std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
   std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
   uint32_t block_count = 0;
-  uint32_t max_window = 0;              // most keys any record holds (block keys + 4)
   std::vector<uint32_t> record_offset;  // [block * block_curves + curve]: byte offset in payload
   std::vector<uint8_t> payload;         // records, then kPayloadPadding zero bytes
 
@@ -115,7 +114,6 @@ inline uint64_t read_bits(const uint8_t* p, uint64_t bit, uint32_t width) noexce
   std::memcpy(&x, p + (bit >> 3), 8);  // little-endian hosts (the x86-64 and ARM we build for)
   return (x >> (bit & 7)) & ((uint64_t(1) << width) - 1);
 }
-inline int64_t unzigzag(uint64_t u) noexcept { return static_cast<int64_t>(u >> 1) ^ -static_cast<int64_t>(u & 1); }
 
 // One record's window around position t (0 <= t < kBlockFrames: frame block_start + t, or the
 // block's first or last frame for positions outside it): key j is the last key at or before

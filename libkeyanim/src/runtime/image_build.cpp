@@ -231,7 +231,6 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   uint64_t total = 0;
   for (size_t r = 0; r < records; ++r) {
     if (total > UINT32_MAX) throw std::bad_alloc();
-    img->max_window = std::max(img->max_window, static_cast<uint32_t>(plans[r].last - plans[r].first + kContextKeys));
     img->record_offset[r] = static_cast<uint32_t>(total);
     total += plans[r].size_bytes;
   }
