@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "gltf_output.h"
 #include "io.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/decode.h"
@@ -10,22 +11,34 @@
 namespace keyanim::cli {
 
 const char* const kDecodeHelp =
-    "usage: keyanim decode IN.kanim [-o OUT.bvh] [--fps F | --inbetweens N] [--frames A:B] [-f]\n"
+    "usage: keyanim decode IN.kanim [-o OUT.bvh|OUT.glb|OUT.gltf] [--to bvh|gltf] [--fps F | --inbetweens N]\n"
+    "                      [--frames A:B] [--error E|E%] [-f]\n"
     "Rebuilds every frame from the keyframes by Cardinal interpolation.\n"
-    "  -o, --output FILE     output (default: IN with .bvh; '-' = standard output)\n"
+    "  -o, --output FILE     output (default: IN with .bvh, or .glb with --to gltf; '-' = standard output)\n"
     "  --fps F               resample at F frames per second (F > 0; default: the source rate).\n"
     "                        In-between frames come from the curves: motion tweening.\n"
-    "  --inbetweens N        N extra frames in every source frame interval (default 0)\n"
+    "  --inbetweens N        N extra frames in every source frame interval (default 0; BVH only)\n"
     "  --frames A:B          source frames A to B inclusive (default: all; A <= B < frame count)\n"
+    "  --to bvh|gltf         output format (default: by the output's extension, .glb/.gltf: glTF)\n"
     "The BVH is written as it is decoded (memory does not grow with its length); a request for\n"
-    "more than --max-values values (frames x channels) is refused before any is made (exit 6).\n";
+    "more than --max-values values (frames x channels) is refused before any is made (exit 6).\n"
+    "glTF 2.0 output (.gltf writes its buffer to OUT.bin beside it; '-' gets a .glb): one node per\n"
+    "joint and End Site, one animation. Translations are the clip's curves exactly (CUBICSPLINE);\n"
+    "rotations are quaternion keys fitted so that every joint, End Site and shell point (2% of\n"
+    "the skeleton size along each joint's axes) stays within --error of the clip at every source\n"
+    "frame, as a glTF player computes it. With --fps, LINEAR keys every 1/F s instead (the error\n"
+    "is reported, not bounded). Time 0 is the first exported frame.\n"
+    "  --error E|E%          rotation fit tolerance, length units or percent of the skeleton size\n"
+    "                        (default: the tolerance the clip was encoded with, else 0.05%)\n";
 
 int cmd_decode(const Argv& argv, Globals& g) {
-  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames"}, {});
+  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames", "--to", "--error"}, {});
   if (args.positional().size() != 1) fail(kUsage, "decode takes one input file");
   const std::string in = args.positional()[0];
   std::string out = args.get("-o").value_or("");
-  if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".bvh");
+  const bool gltf = wants_gltf(args, out);
+  if (out.empty()) out = in == "-" ? "-" : swap_extension(in, gltf ? ".glb" : ".bvh");
+  if (args.has("--error") && !gltf) fail(kUsage, "--error applies to glTF output (--to gltf)");
 
   offline::ResampleOptions opt;
   if (args.has("--fps") && args.has("--inbetweens")) fail(kUsage, "--fps and --inbetweens exclude each other");
@@ -40,6 +53,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
   }
 
   Input input(in, g);
+  if (gltf) return decode_gltf(input, out, opt, args, g);
   Output output(out, false, g, ids_of({&input}));
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
   if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())

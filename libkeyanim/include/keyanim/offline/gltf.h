@@ -1,0 +1,80 @@
+// glTF 2.0 export of a loaded clip: one node per joint and End Site, one animation that a
+// glTF player (three.js, Babylon.js, Godot, Unity glTFast, Unreal, Blender) plays as keyanim
+// decodes the clip.
+//
+// What is exact and what is fitted:
+//  - Translations (position channels, and OFFSET components without one) become CUBICSPLINE
+//    (LINEAR where every axis is linear or constant) whose keys are the union of the axes' key
+//    frames. Every Cardinal segment is a cubic, and a cubic split at any time is the same
+//    cubic, so the curve is exactly the clip's: values at key times are the decoder's values
+//    bit for bit; tangents (Hermite tangents over the segment's duration) are rounded once to
+//    float32.
+//  - Rotations: Euler curves are not quaternion splines, so quaternion keys are fitted (LINEAR,
+//    or CUBICSPLINE where fewer bytes) until forward kinematics of what a glTF player computes
+//    stays within the tolerance of the clip's own forward kinematics at every source frame, for
+//    every joint, End Site and shell point (three points per joint at the shell distance along
+//    its local x, y and z axes). LINEAR is checked both as the glTF spec's slerp and as the
+//    normalised lerp some players use (three.js below 1.8 degrees, Blender), CUBICSPLINE as the
+//    spec's spline, normalised.
+//  - Times are seconds in float32, as glTF stores them; the checks evaluate at the player's
+//    times, rounding included.
+// Nodes carry the rest pose: translation = OFFSET, no rotation. Lengths stay in the file's
+// units (glTF assumes metres: a viewer may need to scale a clip captured in centimetres).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "keyanim/clip.h"
+
+namespace keyanim::offline {
+
+struct GltfOptions {
+  // World-space tolerance of the rotation fit, in file length units, or in percent of the
+  // skeleton size with tolerance_in_percent. Defaults to 0: the tolerance the clip was encoded
+  // with (its encoder note tolerance_units), or 0.05% of the skeleton size (the encoder's
+  // default) when the clip has no such note.
+  double tolerance = 0.0;
+  bool tolerance_in_percent = false;  // Defaults to false.
+  // Shell points at this percent of the skeleton size (largest side of the rest-pose box).
+  // Defaults to 2 (the project's shell metric); 0 measures joints and End Sites only.
+  double shell_percent = 2.0;
+  // Defaults to 0: sparse fitted keys. F > 0: LINEAR keys every 1/F s from the range's start,
+  // and one at its end, no fit; the error is measured and reported, not bounded.
+  double fps = 0.0;
+  uint32_t first_frame = 0;          // Defaults to 0: source frames to export (inclusive);
+  uint32_t last_frame = UINT32_MAX;  // Defaults to the last frame. Time 0 is first_frame.
+  // Defaults to "": a binary .glb. Otherwise a .gltf JSON whose buffer is the file at this URI
+  // (relative, e.g. "walk.bin"), returned separately.
+  std::string bin_uri;
+  std::string name = "keyanim";      // the animation's name
+};
+
+struct GltfReport {
+  double tolerance = 0.0;       // what rotations were fitted within, file length units
+  double shell_distance = 0.0;  // file length units (0: no shell points)
+  // Largest distance, over the source frames of the range and every joint, End Site and shell
+  // point, between the clip's forward kinematics and a glTF player's (the worse of slerp and
+  // normalised lerp for LINEAR rotations), and where it is.
+  double max_error = 0.0;
+  uint32_t worst_node = 0;
+  int worst_axis = -1;          // -1: the node itself; 0, 1, 2: its shell point on x, y, z
+  uint32_t worst_frame = 0;     // source frame
+  uint32_t nodes = 0;
+  uint32_t translation_tracks = 0, translation_keys = 0;
+  uint32_t linear_rotation_tracks = 0, cubic_rotation_tracks = 0, rotation_keys = 0;
+  uint32_t rounds = 0;          // verification rounds of the rotation fit
+};
+
+struct GltfOutput {
+  std::string main;  // the .glb, or the .gltf JSON when options.bin_uri is set
+  std::string bin;   // the .bin buffer of a .gltf (may be empty: then no buffer is referenced)
+};
+
+// Builds the asset. Returns false (and says why in `error`, `out` left empty) for options that
+// make no sense (tolerance or fps not positive and finite, shell_percent negative, an empty or
+// reversed frame range, last_frame beyond the clip), a clip whose frame time is not positive
+// while it has several frames, or a tolerance that float32 keys cannot hold.
+bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
+                 std::string& error);
+
+}  // namespace keyanim::offline

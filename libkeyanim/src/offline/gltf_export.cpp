@@ -1,0 +1,188 @@
+// export_gltf (keyanim/offline/gltf.h): options and the frame window, translations mapped,
+// rotations fitted or resampled, the result checked and written.
+#include <cmath>
+#include <sstream>
+
+#include "gltf_curves.h"
+#include "gltf_rotation_fit.h"
+#include "gltf_verify.h"
+#include "gltf_writer.h"
+#include "keyanim/offline/decode.h"
+#include "keyanim/offline/encode.h"
+#include "keyanim/offline/gltf.h"
+
+namespace keyanim::offline {
+namespace {
+
+using namespace gltf;
+
+constexpr double kDefaultTolerancePercent = 0.05;  // the encoder's default
+// Working memory (per frame of the window: reference points, rotation targets) and output
+// keys beyond these are refused rather than allocated.
+constexpr double kMaxWorkingBytes = double(1u << 30);
+constexpr double kMaxResampledKeys = double(1u << 24);
+
+// The value of `key=` in the encoder notes, or 0.
+double note_value(const std::string& notes, const std::string& key) {
+  std::istringstream in(notes);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.compare(0, key.size() + 1, key + "=") == 0) {
+      const double v = std::strtod(line.c_str() + key.size() + 1, nullptr);
+      return std::isfinite(v) && v > 0.0 ? v : 0.0;
+    }
+  return 0.0;
+}
+
+bool check_options(const Clip& clip, const GltfOptions& o, Window& w, std::string& error) {
+  if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) error = "fps must be positive and finite";
+  else if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
+    error = "tolerance must be positive and finite (at most 100 in percent)";
+  else if (!(o.shell_percent >= 0.0) || !std::isfinite(o.shell_percent)) error = "shell distance must be >= 0";
+  if (!error.empty()) return false;
+  const uint32_t frames = clip.frame_count();
+  const bool ranged = o.first_frame != 0 || o.last_frame != UINT32_MAX;
+  if (frames == 0) {
+    if (ranged) error = "the clip has no frames";
+    return !ranged;
+  }
+  w.first = o.first_frame;
+  w.last = o.last_frame == UINT32_MAX ? frames - 1 : o.last_frame;
+  w.frame_time = clip.frame_time();
+  if (w.first > w.last || w.last >= frames)
+    error = "frame range " + std::to_string(w.first) + ":" + std::to_string(w.last) + " is not within 0:" +
+            std::to_string(frames - 1);
+  else if (w.last > w.first && !(w.frame_time > 0.0))
+    error = "the clip's frame time is not positive";
+  return error.empty();
+}
+
+// Frame positions and player times of the --fps keys: every 1/fps s from the range's start
+// (as decode_motion resamples), and the range's end.
+bool resample_positions(const Window& w, double fps, std::vector<double>& positions, std::vector<double>& times,
+                        std::string& error) {
+  const double duration = double(w.last - w.first) * w.frame_time;
+  const double count = std::floor(duration * fps + 1e-6) + 1.0;
+  if (!(count <= kMaxResampledKeys)) {
+    error = "--fps " + json_number(fps) + " over " + json_number(duration) + " s makes too many keys";
+    return false;
+  }
+  for (uint32_t i = 0; i < uint32_t(count); ++i) {
+    const double t = double(i) / fps;
+    times.push_back(t);
+    positions.push_back(w.frame_time > 0.0 ? double(w.first) + t / w.frame_time : double(w.first));
+  }
+  // Unlike BVH frames, glTF keys need not be evenly spaced: a last key at the range's end keeps
+  // the animation as long as the clip.
+  if (float(times.back()) < float(duration)) {
+    times.push_back(duration);
+    positions.push_back(double(w.last));
+  }
+  return true;
+}
+
+// What percentages are of, as the encoder measures it (encode.h's reference_size): a
+// skeleton without extent (a lone root) falls back to the box its nodes sweep over the clip.
+double reference_size(const Clip& clip) {
+  const double size = skeleton_size(clip.skeleton());
+  const double decoded_bytes = double(clip.frame_count()) * double(clip.channel_count()) * sizeof(double);
+  Motion motion;
+  std::string ignored;
+  if (size > 0.0 || !(decoded_bytes <= kMaxWorkingBytes) || !decode_motion(clip, {}, motion, ignored)) return size;
+  return offline::reference_size(motion);
+}
+
+std::string extras(const GltfReport& r, const Window& w, double fps) {
+  std::string o = "{\"keyanim\":{\"tolerance\":" + json_number(r.tolerance) +
+                  ",\"shell_distance\":" + json_number(r.shell_distance) + ",\"max_error\":" + json_number(r.max_error) +
+                  ",\"first_frame\":" + std::to_string(w.first) + ",\"last_frame\":" + std::to_string(w.last) +
+                  ",\"source_frame_time\":" + json_number(w.frame_time);
+  if (fps > 0.0) o += ",\"fps\":" + json_number(fps);
+  return o + "}}";
+}
+
+}  // namespace
+
+bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
+                 std::string& error) {
+  out = {};
+  report = {};
+  error.clear();
+  Window w;
+  if (!check_options(clip, options, w, error)) return false;
+  Model model;
+  model.skeleton = clip.skeleton();
+  model.animation_name = options.name;
+  const Skeleton& sk = model.skeleton;
+  model.nodes.resize(sk.joints.size());
+  report.nodes = uint32_t(sk.joints.size());
+
+  // Per frame and node of the window: reference points, rotation targets.
+  const double working = double(w.frames()) * double(sk.joints.size()) * (4 * sizeof(Vec3) + 96);
+  if (!(working <= kMaxWorkingBytes)) {
+    error = "the clip is too long for one glTF export (" + std::to_string(w.frames()) + " frames of " +
+            std::to_string(sk.joints.size()) + " nodes): export it in frame ranges";
+    return false;
+  }
+  const double size = reference_size(clip);
+  double tol = options.tolerance_in_percent ? options.tolerance / 100.0 * size : options.tolerance;
+  if (!(tol > 0.0)) tol = note_value(clip.encoder_notes(), "tolerance_units");
+  if (!(tol > 0.0)) tol = kDefaultTolerancePercent / 100.0 * size;
+  if (!(tol > 0.0) && clip.frame_count() > 0) {
+    error = "the tolerance is 0 (the skeleton has no size): give one in length units";
+    return false;
+  }
+  report.tolerance = tol;
+  report.shell_distance = options.shell_percent / 100.0 * size;
+
+  if (clip.frame_count() > 0) {
+    std::vector<ChannelCurve> curves;
+    for (uint32_t c = 0; c < clip.channel_count(); ++c) curves.emplace_back(clip, c);
+    std::vector<NodeCurves> nodes;
+    for (const Joint& j : sk.joints) nodes.push_back(node_curves(j));
+    const Reference reference(sk, curves, w, report.shell_distance);
+
+    if (options.fps > 0.0) {
+      std::vector<double> positions, times;
+      if (!resample_positions(w, options.fps, positions, times, error)) return false;
+      for (size_t j = 0; j < sk.joints.size(); ++j) {
+        if (!translation_at_rest(nodes[j], curves))
+          model.nodes[j].translation = resampled_translation(nodes[j], curves, positions, times);
+        if (!nodes[j].rotation.empty() && !rotation_at_rest(nodes[j], curves))
+          model.nodes[j].rotation = resampled_rotation(nodes[j], curves, positions, times);
+      }
+    } else {
+      for (size_t j = 0; j < sk.joints.size(); ++j)
+        if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
+      if (!fit_rotations(model, nodes, curves, reference, tol, report.rounds, error)) return false;
+    }
+    // Every export carries one animation spanning the range, even if nothing moves.
+    bool animated = false;
+    for (const NodeAnimation& n : model.nodes) animated = animated || n.translation || n.rotation;
+    if (!animated && !sk.joints.empty()) model.nodes[0].translation = translation_sampler(nodes[0], curves, w);
+
+    const CheckResult check = check_model(model, reference, tol);
+    report.max_error = check.max_error;
+    report.worst_node = reference.owner(check.worst_point);
+    report.worst_axis = reference.moved_by_owner(check.worst_point) ? int(check.worst_point - report.nodes) % 3 : -1;
+    report.worst_frame = w.first + check.worst_frame_index;
+  }
+  for (const NodeAnimation& n : model.nodes) {
+    if (n.translation) ++report.translation_tracks, report.translation_keys += uint32_t(n.translation->key_count());
+    if (n.rotation) {
+      ++(n.rotation->interp == Interp::cubic ? report.cubic_rotation_tracks : report.linear_rotation_tracks);
+      report.rotation_keys += uint32_t(n.rotation->key_count());
+    }
+  }
+  model.extras_json = extras(report, w, options.fps);
+  if (options.bin_uri.empty()) out.main = write_glb(model);
+  else write_gltf(model, options.bin_uri, out.main, out.bin);
+  if (out.main.size() + out.bin.size() >= (uint64_t(1) << 32)) {  // GLB and glTF lengths are u32
+    out = {};
+    error = "the glTF asset would exceed 4 GiB: export it in frame ranges";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace keyanim::offline

@@ -1,0 +1,217 @@
+// Checks keyanim's glTF exports with tools that share no code with keyanim:
+//  - the Khronos glTF-Validator: no error and no warning;
+//  - the asset's structure against the BVH: one node per joint and End Site, names, hierarchy,
+//    rest translations = OFFSET, one animation spanning the clip, accessors with min/max;
+//  - three.js (GLTFLoader + AnimationMixer, under node) playing the animation at every source
+//    frame, every node's world position and every joint's shell points (at the export's shell
+//    distance along its local axes) compared with forward kinematics of
+//      CLIP.bvh: the .kanim decoded by keyanim (what the export had to reproduce): within the
+//                export's tolerance (the rotation fit's guarantee);
+//      ORIG.bvh: the original capture: joints and End Sites within the clip's tolerance plus the
+//                export's (the encoder's guarantee plus the fit's); shell points reported.
+// usage: node check_export.mjs [--percent P] [--fps] ORIG.bvh CLIP.bvh OUT.glb [ORIG CLIP GLB ...]
+//   OUT may also be a .gltf (its .bin beside it): validated as it is, played as the same GLB.
+//   --percent P  the tolerance the clips were encoded with, in percent of the skeleton size
+//                (default 0.05); the export's tolerance must be that (its default)
+//   --fps        the exports were resampled (--fps): the error is bounded by what the export
+//                reports (asset.extras.keyanim.max_error), not by the tolerance
+// Prints one line per file; exits 1 if any check fails.
+import fs from 'node:fs';
+import path from 'node:path';
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import validator from 'gltf-validator';
+import { readBvh, skeletonSize, framePoints, pointName } from './bvh.mjs';
+
+const args = process.argv.slice(2);
+let percent = 0.05, fpsMode = false;
+const files = [];
+for (let i = 0; i < args.length; ++i) {
+  if (args[i] === '--percent') percent = Number(args[++i]);
+  else if (args[i] === '--fps') fpsMode = true;
+  else files.push(args[i]);
+}
+if (files.length === 0 || files.length % 3 !== 0) {
+  console.error('usage: node check_export.mjs [--percent P] [--fps] ORIG.bvh CLIP.bvh OUT.glb ...');
+  process.exit(2);
+}
+
+let failures = 0;
+function fail(file, message) {
+  console.error(`FAIL ${file}: ${message}`);
+  ++failures;
+}
+
+// The JSON chunk of a GLB.
+function glbJson(bytes) {
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  if (view.getUint32(0, true) !== 0x46546c67) throw new Error('not a GLB');
+  const length = view.getUint32(12, true);
+  return JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + length)));
+}
+
+// A .glb as bytes, or a .gltf with its external buffer: {json, glb (bytes to play), validate()}.
+function readAsset(file) {
+  const name = path.basename(file);
+  if (!file.endsWith('.gltf')) {
+    const bytes = fs.readFileSync(file);
+    return { json: glbJson(bytes), glb: bytes, validate: () => validator.validateBytes(new Uint8Array(bytes), { uri: name, maxIssues: 0 }) };
+  }
+  const text = fs.readFileSync(file, 'utf8');
+  const json = JSON.parse(text);
+  const external = (uri) => new Uint8Array(fs.readFileSync(path.join(path.dirname(file), decodeURIComponent(uri))));
+  const bin = json.buffers ? external(json.buffers[0].uri) : new Uint8Array(0);
+  return { json, glb: makeGlb(json, bin),
+           validate: () => validator.validateString(text, { uri: name, maxIssues: 0, externalResourceFunction: async (u) => external(u) }) };
+}
+
+// The same asset as a GLB: the buffer embedded instead of referenced.
+function makeGlb(json, bin) {
+  const copy = JSON.parse(JSON.stringify(json));
+  if (copy.buffers) delete copy.buffers[0].uri;
+  let text = JSON.stringify(copy);
+  while (text.length % 4) text += ' ';
+  const jsonBytes = new TextEncoder().encode(text);
+  const binLength = bin.length ? 8 + bin.length + ((4 - bin.length % 4) % 4) : 0;
+  const out = Buffer.alloc(12 + 8 + jsonBytes.length + binLength);
+  out.writeUInt32LE(0x46546c67, 0); out.writeUInt32LE(2, 4); out.writeUInt32LE(out.length, 8);
+  out.writeUInt32LE(jsonBytes.length, 12); out.writeUInt32LE(0x4e4f534a, 16); out.set(jsonBytes, 20);
+  if (bin.length) {
+    const at = 20 + jsonBytes.length;
+    out.writeUInt32LE(binLength - 8, at); out.writeUInt32LE(0x004e4942, at + 4); out.set(bin, at + 8);
+  }
+  return out;
+}
+
+async function validate(file, asset) {
+  const report = await asset.validate();
+  const { numErrors, numWarnings, messages } = report.issues;
+  if (numErrors > 0 || numWarnings > 0) {
+    const shown = messages.filter((m) => m.severity <= 1).slice(0, 5).map((m) => `${m.code} ${m.pointer}: ${m.message}`);
+    fail(file, `glTF-Validator: ${numErrors} errors, ${numWarnings} warnings: ${shown.join('; ')}`);
+  }
+}
+
+function checkStructure(file, gltf, bvh) {
+  const nodes = gltf.nodes || [];
+  if (nodes.length !== bvh.nodes.length) return fail(file, `${nodes.length} nodes, the BVH has ${bvh.nodes.length}`);
+  const roots = [];
+  bvh.nodes.forEach((n, j) => {
+    const g = nodes[j];
+    const name = n.endSite ? `${bvh.nodes[n.parent].name}_End` : n.name;
+    if (g.name !== name) fail(file, `node ${j} is named '${g.name}', expected '${name}'`);
+    const t = g.translation || [0, 0, 0];
+    if (t.some((v, a) => v !== n.offset[a])) fail(file, `node ${j} (${name}): translation ${t} is not OFFSET ${n.offset}`);
+    if (g.rotation || g.scale || g.matrix) fail(file, `node ${j} (${name}): rest pose is not OFFSET only`);
+    const children = bvh.nodes.map((c, k) => k).filter((k) => bvh.nodes[k].parent === j);
+    if (JSON.stringify(g.children || []) !== JSON.stringify(children)) fail(file, `node ${j} (${name}): children ${g.children}`);
+    if (n.parent < 0) roots.push(j);
+  });
+  if (JSON.stringify(gltf.scenes[gltf.scene].nodes) !== JSON.stringify(roots)) fail(file, 'scene roots differ from the BVH roots');
+  if ((gltf.animations || []).length !== 1) return fail(file, `${(gltf.animations || []).length} animations, expected 1`);
+  for (const a of gltf.accessors || [])
+    if (!a.min || !a.max) fail(file, 'an accessor without min/max');
+  for (const s of gltf.animations[0].samplers)
+    if (!['LINEAR', 'CUBICSPLINE'].includes(s.interpolation) || (fpsMode && s.interpolation !== 'LINEAR'))
+      fail(file, `sampler interpolation ${s.interpolation}`);
+}
+
+async function loadGlb(bytes) {
+  const ab = bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength);
+  return new Promise((resolve, reject) => new GLTFLoader().parse(ab, '', resolve, reject));
+}
+
+// Plays the animation at source frame f (time f * frameTime) and returns the measured points in
+// framePoints' order.
+function player(gltf, json, bvh, shell) {
+  const objects = [];
+  for (const [object, ref] of gltf.parser.associations) if (ref && ref.nodes !== undefined) objects[ref.nodes] = object;
+  const mixer = new THREE.AnimationMixer(gltf.scene);
+  const action = mixer.clipAction(gltf.animations[0]);
+  action.setLoop(THREE.LoopOnce);
+  action.clampWhenFinished = true;
+  action.play();
+  const v = new THREE.Vector3();
+  return (f) => {
+    action.reset();  // LoopOnce pauses at the end; start again from time 0
+    mixer.setTime(f * bvh.frameTime);
+    gltf.scene.updateMatrixWorld(true);
+    const points = objects.map((o) => v.setFromMatrixPosition(o.matrixWorld).toArray());
+    if (shell > 0)
+      bvh.nodes.forEach((n, j) => {
+        if (n.endSite) return;
+        for (let a = 0; a < 3; ++a) {
+          const local = [0, 0, 0];
+          local[a] = shell;
+          points.push(v.fromArray(local).applyMatrix4(objects[j].matrixWorld).toArray());
+        }
+      });
+    return points;
+  };
+}
+
+function distance(a, b) { return Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]); }
+
+async function checkFile(origPath, clipPath, glbPath) {
+  const name = path.basename(glbPath);
+  const asset = readAsset(glbPath);
+  await validate(name, asset);
+  const json = asset.json, bytes = asset.glb;
+  const orig = readBvh(origPath), clip = readBvh(clipPath);
+  checkStructure(name, json, clip);
+  const size = skeletonSize(orig);
+  const extras = json.asset.extras.keyanim;
+  const tol = extras.tolerance, shell = extras.shell_distance;
+  const clipTol = percent / 100 * size;
+  if (!(Math.abs(tol - clipTol) <= 1e-5 * clipTol)) fail(name, `tolerance ${tol}, expected ${percent}% of ${size}`);
+  // The export measures the size on the clip it was given (they differ only for a skeleton
+  // without extent, whose size is the box it sweeps).
+  const clipSize = skeletonSize(clip);
+  if (!(Math.abs(shell - 0.02 * clipSize) <= 1e-12 * clipSize)) fail(name, `shell distance ${shell}, expected 2% of ${clipSize}`);
+  if (clip.frames !== orig.frames) fail(name, `the decoded clip has ${clip.frames} frames, the original ${orig.frames}`);
+
+  const gltf = await loadGlb(bytes);
+  const duration = (clip.frames - 1) * clip.frameTime;
+  if (!(Math.abs(gltf.animations[0].duration - duration) <= 1e-6 * Math.max(1, duration)))
+    fail(name, `animation lasts ${gltf.animations[0].duration} s, the clip ${duration} s`);
+  const play = player(gltf, json, clip, shell);
+  // Bounds: the fit's tolerance against the clip (or the reported error with --fps); against
+  // the original, the encoder's plus the fit's. Slack: binary64 evaluation-order differences.
+  const slack = 1e-6 * tol + 1e-9 * size;
+  const boundClip = (fpsMode ? extras.max_error : tol) + slack;
+  const boundOrig = clipTol + (fpsMode ? extras.max_error : tol) + slack;
+  const worst = { clip: [0], origNode: [0], origShell: [0], clipVsOrig: [0] };
+  const note = (key, e, p, f) => { if (!(e <= worst[key][0])) worst[key] = [e, p, f]; };
+  const nodeCount = clip.nodes.length;
+  for (let f = 0; f < clip.frames; ++f) {
+    const got = play(f);
+    const refClip = framePoints(clip, f, shell), refOrig = framePoints(orig, f, shell);
+    if (got.length !== refClip.length) return fail(name, `${got.length} points played, ${refClip.length} expected`);
+    for (let p = 0; p < got.length; ++p) {
+      note('clip', distance(got[p], refClip[p]), p, f);
+      note(p < nodeCount ? 'origNode' : 'origShell', distance(got[p], refOrig[p]), p, f);
+      note('clipVsOrig', distance(refClip[p], refOrig[p]), p, f);
+    }
+  }
+  const where = (w) => (w.length > 1 ? `${pointName(clip, w[1])}, frame ${w[2]}` : '-');
+  if (!(worst.clip[0] <= boundClip)) fail(name, `three.js vs the clip: ${worst.clip[0]} at ${where(worst.clip)} > ${boundClip}`);
+  if (!(worst.origNode[0] <= boundOrig))
+    fail(name, `three.js vs the original: ${worst.origNode[0]} at ${where(worst.origNode)} > ${boundOrig}`);
+  // In units of the tolerance: three.js vs clip (all points), vs original (nodes; shell), clip vs original.
+  const r = (x) => (x / tol).toFixed(3);
+  console.log(`${name.padEnd(48)} ${String(clip.frames).padStart(5)} frames ${String(bytes.length).padStart(9)} B  ` +
+              `tol ${tol.toPrecision(4)}  player-vs-clip ${r(worst.clip[0])}  vs-orig nodes ${r(worst.origNode[0])} ` +
+              `shell ${r(worst.origShell[0])}  clip-vs-orig ${r(worst.clipVsOrig[0])}  (${where(worst.clip)})`);
+}
+
+for (let i = 0; i < files.length; i += 3) {
+  try {
+    await checkFile(files[i], files[i + 1], files[i + 2]);
+  } catch (e) {
+    fail(path.basename(files[i + 2]), e.stack || String(e));
+  }
+}
+if (failures > 0) {
+  console.error(`${failures} check(s) failed`);
+  process.exit(1);
+}

@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# glTF export, checked by tools that share no code with keyanim (check_export.mjs: the Khronos
+# glTF-Validator, three.js playing the export, BVH forward kinematics written in JS).
+#   gltf_test.sh KEYANIM DATA_DIR cli            the command's behaviour on the shipped clips
+#   gltf_test.sh KEYANIM CORPUS_DIR corpus FILE_GLOB...  every matching corpus file: encode at
+#                                                0.05%, export with the defaults, check
+# Needs node and this folder's node_modules (scripts/install-deps.sh: npm ci). Exits 77
+# (skipped) when the corpus is absent.
+set -uo pipefail
+HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+K=$(realpath "$1"); DIR=$(realpath -m "$2"); CASE="$3"; shift 3
+die() { echo "FAIL: $*" >&2; exit 1; }
+command -v node >/dev/null || die "node not found: run scripts/install-deps.sh"
+[ -d "$HERE/node_modules/three" ] && [ -d "$HERE/node_modules/gltf-validator" ] ||
+  die "tests/gltf/node_modules missing: run scripts/install-deps.sh (npm ci in tests/gltf)"
+CHECK="$HERE/check_export.mjs"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+cd "$T" || exit 1
+expect_rc() {  # expect_rc CODE command...
+  local want=$1; shift
+  "$@" >"$T/.stdout" 2>"$T/.stderr"; local rc=$?
+  [ "$rc" -eq "$want" ] || { cat "$T/.stderr" >&2; die "'$*' exited $rc, expected $want"; }
+}
+extras() {  # extras FILE.glb FIELD: a number from asset.extras.keyanim
+  node -e 'const b=require("fs").readFileSync(process.argv[1]);const n=b.readUInt32LE(12);
+           console.log(JSON.parse(b.subarray(20,20+n)).asset.extras.keyanim[process.argv[2]])' "$1" "$2"
+}
+
+case "$CASE" in
+cli)
+  WALK="$DIR/cmu_02_01_walk.bvh"; HOP="$DIR/cmu_131_03_hop.bvh"
+  expect_rc 0 "$K" encode "$WALK" -o walk.kanim --error 0.05%
+  expect_rc 0 "$K" encode "$HOP" -o hop.kanim --error 0.05%
+  expect_rc 0 "$K" decode walk.kanim -o walk.bvh
+  expect_rc 0 "$K" decode hop.kanim -o hop.bvh
+  # By extension: .glb, and .gltf with its .bin; --to gltf names the output IN.glb.
+  expect_rc 0 "$K" decode walk.kanim -o walk.glb
+  grep -q 'walk.kanim -> walk.glb: .* error max .* tolerance' .stderr || die "no summary: $(cat .stderr)"
+  expect_rc 0 "$K" decode walk.kanim -o split.gltf
+  [ -s split.bin ] || die ".gltf output wrote no split.bin"
+  grep -q '"uri":"split.bin"' split.gltf || die "split.gltf does not reference split.bin"
+  expect_rc 0 "$K" decode hop.kanim --to gltf
+  [ -s hop.glb ] || die "--to gltf did not write hop.glb"
+  node "$CHECK" "$WALK" walk.bvh walk.glb "$WALK" walk.bvh split.gltf "$HOP" hop.bvh hop.glb || die "exports fail their checks"
+  # To standard output: a GLB, the same bytes as the file.
+  "$K" decode walk.kanim --to gltf -o - >stdout.glb || die "decode to standard output"
+  cmp -s stdout.glb walk.glb || die "standard output differs from the .glb"
+  # --to bvh wins over the extension.
+  expect_rc 0 "$K" decode walk.kanim --to bvh -o really-bvh.glb
+  head -c 9 really-bvh.glb | grep -q HIERARCHY || die "--to bvh did not write BVH"
+  # --error sets the tolerance (percent of the skeleton size, or units).
+  expect_rc 0 "$K" decode walk.kanim -o coarse.glb --error 0.5%
+  node -e 'const [a,b]=process.argv.slice(1).map(Number); process.exit(Math.abs(a-10*b)<=1e-4*a?0:1)' \
+    "$(extras coarse.glb tolerance)" "$(extras walk.glb tolerance)" || die "--error 0.5% is not ten times the default"
+  [ "$(stat -c %s coarse.glb)" -lt "$(stat -c %s walk.glb)" ] || die "a ten times larger tolerance is not smaller"
+  expect_rc 0 "$K" decode walk.kanim -o units.glb --error 0.1
+  [ "$(extras units.glb tolerance)" = 0.1 ] || die "--error 0.1 gave $(extras units.glb tolerance)"
+  # --fps: LINEAR keys resampled; three.js stays within the error the export reports.
+  expect_rc 0 "$K" decode hop.kanim -o hop30.glb --fps 30
+  node "$CHECK" --fps "$HOP" hop.bvh hop30.glb || die "--fps export fails its checks"
+  # --frames: a range, time 0 at its first frame, checked against the BVH of the same range.
+  expect_rc 0 "$K" decode walk.kanim -o range.glb --frames 100:200
+  expect_rc 0 "$K" decode walk.kanim -o range.bvh --frames 100:200
+  node "$CHECK" range.bvh range.bvh range.glb || die "--frames export fails its checks"
+  # Refusals: existing outputs (nothing written, not even the .bin), BVH-only and glTF-only
+  # options, a tolerance float32 cannot hold, the input as output.
+  expect_rc 4 "$K" decode walk.kanim -o walk.glb
+  touch only.gltf
+  expect_rc 4 "$K" decode walk.kanim -o only.gltf
+  [ ! -e only.bin ] || die "a refused .gltf output still wrote its .bin"
+  expect_rc 0 "$K" decode walk.kanim -o walk.glb -f
+  expect_rc 1 "$K" decode walk.kanim -o x.glb --inbetweens 2
+  expect_rc 1 "$K" decode walk.kanim -o x.bvh --error 0.1
+  expect_rc 1 "$K" decode walk.kanim -o x.glb --to fbx
+  expect_rc 1 "$K" decode walk.kanim -o x.glb --error 1e-12
+  grep -q 'float32' .stderr || die "an impossible tolerance is not explained: $(cat .stderr)"
+  [ ! -e x.glb ] || die "a failed export left x.glb"
+  cp walk.kanim walk.bin
+  expect_rc 1 "$K" decode walk.bin -o walk.gltf -f
+  cmp -s walk.bin walk.kanim || die "the input was overwritten by the .gltf's buffer"
+  echo "glTF CLI cases passed"
+  ;;
+corpus)
+  [ -d "$DIR" ] || { echo "corpus not found at $DIR: glTF corpus tests skipped"; exit 77; }
+  triples=()
+  for pattern in "$@"; do
+    for bvh in "$DIR"/$pattern; do
+      [ -f "$bvh" ] || continue
+      base=$(basename "$bvh" .bvh)
+      "$K" -q encode "$bvh" -o "$base.kanim" --error 0.05% || die "encode $bvh"
+      "$K" -q decode "$base.kanim" -o "$base.clip.bvh" || die "decode $base.kanim to BVH"
+      "$K" decode "$base.kanim" -o "$base.glb" || die "decode $base.kanim to glTF"
+      triples+=("$bvh" "$base.clip.bvh" "$base.glb")
+    done
+  done
+  [ ${#triples[@]} -gt 0 ] || die "no corpus file matches $*"
+  node "$CHECK" --percent 0.05 "${triples[@]}" || die "exports fail their checks"
+  echo "$(( ${#triples[@]} / 3 )) corpus exports validated and played within tolerance"
+  ;;
+*) die "unknown case $CASE" ;;
+esac

@@ -1,0 +1,88 @@
+// keyanim decode to glTF (gltf_output.h).
+#include "gltf_output.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "escape.h"
+#include "keyanim/offline/gltf.h"
+#include "report.h"
+#include "settings.h"
+
+namespace keyanim::cli {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string point_name(const Skeleton& s, const offline::GltfReport& r) {
+  std::string name = node_name(s, r.worst_node);
+  if (r.worst_axis >= 0) name += std::string(" +") + "xyz"[r.worst_axis] + " shell";
+  return name;
+}
+
+}  // namespace
+
+bool wants_gltf(const Args& args, const std::string& out) {
+  if (auto to = args.get("--to")) {
+    if (*to != "bvh" && *to != "gltf") fail(kUsage, "--to expects bvh or gltf, got '" + printable(*to) + "'");
+    return *to == "gltf";
+  }
+  return ends_with(out, ".glb") || ends_with(out, ".gltf");
+}
+
+int decode_gltf(Input& input, const std::string& out, const offline::ResampleOptions& opt, const Args& args,
+                const Globals& g) {
+  if (args.has("--inbetweens")) fail(kUsage, "--inbetweens is for BVH output: a glTF player interpolates itself");
+  const std::string& in = input.path();
+  offline::GltfOptions o;
+  if (auto e = args.get("--error")) {
+    offline::EncodeSettings s;
+    parse_tolerance(*e, s);
+    o.tolerance = s.tolerance;
+    o.tolerance_in_percent = s.tolerance_in_percent;
+  }
+  o.fps = opt.fps;
+  o.first_frame = opt.first_frame;
+  o.last_frame = opt.last_frame;
+  if (in != "-") o.name = std::filesystem::path(in).stem().string();
+  // A .gltf and its .bin, or one .glb: both checked and opened before the work.
+  const bool split = out != "-" && ends_with(out, ".gltf");
+  const std::string bin_path = split ? swap_extension(out, ".bin") : "";
+  std::optional<Output> bin;
+  if (split) {
+    o.bin_uri = std::filesystem::path(bin_path).filename().string();
+    bin.emplace(bin_path, true, g, ids_of({&input}));
+  }
+  Output main(out, !split, g, ids_of({&input}));
+
+  const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
+  check_values(clip.frame_count(), clip.channel_count(), "exporting " + in, g);
+  offline::GltfOutput asset;
+  offline::GltfReport r;
+  std::string error;
+  if (!offline::export_gltf(clip, o, asset, r, error)) fail(kUsage, in + ": glTF export: " + error);
+  if (bin && !asset.bin.empty()) {  // a clip without frames has no buffer: no .bin is left
+    bin->write(asset.bin);
+    bin->commit();
+  }
+  main.write(asset.main);
+  main.commit();
+  if (g.verbosity > 0 && out != "-") {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  ": %zu bytes, %u nodes, %u translation tracks (%u keys), %u rotation tracks (%u LINEAR, "
+                  "%u CUBICSPLINE, %u keys); error max %.6g (%s, frame %u), tolerance %.6g\n",
+                  asset.main.size() + asset.bin.size(), r.nodes, r.translation_tracks, r.translation_keys,
+                  r.linear_rotation_tracks + r.cubic_rotation_tracks, r.linear_rotation_tracks, r.cubic_rotation_tracks,
+                  r.rotation_keys, r.max_error, printable(point_name(clip.skeleton(), r)).c_str(), r.worst_frame,
+                  r.tolerance);
+    std::cerr << printable(in + " -> " + out) << buf;
+  }
+  return kOk;
+}
+
+}  // namespace keyanim::cli
