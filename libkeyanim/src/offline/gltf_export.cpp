@@ -21,6 +21,7 @@ constexpr double kDefaultTolerancePercent = 0.05;  // the encoder's default
 // keys beyond these are refused rather than allocated.
 constexpr double kMaxWorkingBytes = double(1u << 30);
 constexpr double kMaxResampledKeys = double(1u << 24);
+constexpr double kRoundingMargin = 1e-6;  // of the skeleton size
 
 // The value of `key=` in the encoder notes, or 0.
 double note_value(const std::string& notes, const std::string& key) {
@@ -154,7 +155,15 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
     } else {
       for (size_t j = 0; j < sk.joints.size(); ++j)
         if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
-      if (!fit_rotations(model, nodes, curves, reference, tol, report.rounds, error)) return false;
+      // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result
+      // or not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
+      const double fit_tol = tol - kRoundingMargin * size;
+      if (!(fit_tol > 0.0)) {
+        error = "float32 glTF keys cannot hold the tolerance " + json_number(tol) + ": rounding alone reaches " +
+                json_number(kRoundingMargin * size) + " (use a larger --error)";
+        return false;
+      }
+      if (!fit_rotations(model, nodes, curves, reference, fit_tol, report.rounds, error)) return false;
     }
     // Every export carries one animation spanning the range, even if nothing moves.
     bool animated = false;

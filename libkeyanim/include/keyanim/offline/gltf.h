@@ -17,7 +17,8 @@
 //    normalised lerp some players use (three.js below 1.8 degrees, Blender), CUBICSPLINE as the
 //    spec's spline, normalised.
 //  - Times are seconds in float32, as glTF stores them; the checks evaluate at the player's
-//    times, rounding included.
+//    times, rounding included, in binary64 as three.js does, and keep a margin of 1e-6 of the
+//    skeleton size for players that round differently (float32 arithmetic, normalising).
 // Nodes carry the rest pose: translation = OFFSET, no rotation. Lengths stay in the file's
 // units (glTF assumes metres: a viewer may need to scale a clip captured in centimetres).
 #pragma once
