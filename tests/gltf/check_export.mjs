@@ -9,12 +9,14 @@
 //                export's tolerance (the rotation fit's guarantee);
 //      ORIG.bvh: the original capture: joints and End Sites within the clip's tolerance plus the
 //                export's (the encoder's guarantee plus the fit's); shell points reported.
-// usage: node check_export.mjs [--percent P] [--fps] ORIG.bvh CLIP.bvh OUT.glb [ORIG CLIP GLB ...]
+// usage: node check_export.mjs [--percent P] [--linear | --fps] ORIG.bvh CLIP.bvh OUT.glb [ORIG CLIP GLB ...]
 //   OUT may also be a .gltf (its .bin beside it): validated as it is, played as the same GLB.
 //   --percent P  the tolerance the clips were encoded with, in percent of the skeleton size
 //                (default 0.05); the export's tolerance must be that (its default)
-//   --fps        the exports were resampled (--fps): the error is bounded by what the export
-//                reports (asset.extras.keyanim.max_error), not by the tolerance
+//   --linear     the exports were made with --linear: every sampler must be LINEAR
+//   --fps        the exports were resampled (--fps): every sampler LINEAR, and the error is
+//                bounded by what the export reports (asset.extras.keyanim.max_error), not by
+//                the tolerance
 // Prints one line per file; exits 1 if any check fails.
 import fs from 'node:fs';
 import path from 'node:path';
@@ -24,15 +26,16 @@ import validator from 'gltf-validator';
 import { readBvh, skeletonSize, framePoints, pointName } from './bvh.mjs';
 
 const args = process.argv.slice(2);
-let percent = 0.05, fpsMode = false;
+let percent = 0.05, fpsMode = false, linearOnly = false;
 const files = [];
 for (let i = 0; i < args.length; ++i) {
   if (args[i] === '--percent') percent = Number(args[++i]);
-  else if (args[i] === '--fps') fpsMode = true;
+  else if (args[i] === '--fps') fpsMode = linearOnly = true;
+  else if (args[i] === '--linear') linearOnly = true;
   else files.push(args[i]);
 }
 if (files.length === 0 || files.length % 3 !== 0) {
-  console.error('usage: node check_export.mjs [--percent P] [--fps] ORIG.bvh CLIP.bvh OUT.glb ...');
+  console.error('usage: node check_export.mjs [--percent P] [--linear | --fps] ORIG.bvh CLIP.bvh OUT.glb ...');
   process.exit(2);
 }
 
@@ -112,7 +115,7 @@ function checkStructure(file, gltf, bvh) {
   for (const a of gltf.accessors || [])
     if (!a.min || !a.max) fail(file, 'an accessor without min/max');
   for (const s of gltf.animations[0].samplers)
-    if (!['LINEAR', 'CUBICSPLINE'].includes(s.interpolation) || (fpsMode && s.interpolation !== 'LINEAR'))
+    if (!['LINEAR', 'CUBICSPLINE'].includes(s.interpolation) || (linearOnly && s.interpolation !== 'LINEAR'))
       fail(file, `sampler interpolation ${s.interpolation}`);
 }
 

@@ -3,7 +3,8 @@
 # glTF-Validator, three.js playing the export, BVH forward kinematics written in JS).
 #   gltf_test.sh KEYANIM DATA_DIR cli            the command's behaviour on the shipped clips
 #   gltf_test.sh KEYANIM CORPUS_DIR corpus FILE_GLOB...  every matching corpus file: encode at
-#                                                0.05%, export with the defaults, check
+#                                                0.05%, export with the defaults and with
+#                                                --linear, check both
 # Needs node and this folder's node_modules (scripts/install-deps.sh: npm ci). Exits 77
 # (skipped) when the corpus is absent.
 set -uo pipefail
@@ -56,6 +57,9 @@ cli)
   [ "$(stat -c %s coarse.glb)" -lt "$(stat -c %s walk.glb)" ] || die "a ten times larger tolerance is not smaller"
   expect_rc 0 "$K" decode walk.kanim -o units.glb --error 0.1
   [ "$(extras units.glb tolerance)" = 0.1 ] || die "--error 0.1 gave $(extras units.glb tolerance)"
+  # --linear: LINEAR keys only, translations fitted too, still within the tolerance.
+  expect_rc 0 "$K" decode hop.kanim -o hop-linear.glb --linear
+  node "$CHECK" --linear "$HOP" hop.bvh hop-linear.glb || die "--linear export fails its checks"
   # --fps: LINEAR keys resampled; three.js stays within the error the export reports.
   expect_rc 0 "$K" decode hop.kanim -o hop30.glb --fps 30
   node "$CHECK" --fps "$HOP" hop.bvh hop30.glb || die "--fps export fails its checks"
@@ -72,6 +76,7 @@ cli)
   expect_rc 0 "$K" decode walk.kanim -o walk.glb -f
   expect_rc 1 "$K" decode walk.kanim -o x.glb --inbetweens 2
   expect_rc 1 "$K" decode walk.kanim -o x.bvh --error 0.1
+  expect_rc 1 "$K" decode walk.kanim -o x.bvh --linear
   expect_rc 1 "$K" decode walk.kanim -o x.glb --to fbx
   expect_rc 1 "$K" decode walk.kanim -o x.glb --error 1e-12
   grep -q 'float32' .stderr || die "an impossible tolerance is not explained: $(cat .stderr)"
@@ -83,7 +88,7 @@ cli)
   ;;
 corpus)
   [ -d "$DIR" ] || { echo "corpus not found at $DIR: glTF corpus tests skipped"; exit 77; }
-  triples=()
+  triples=(); linear=()
   for pattern in "$@"; do
     for bvh in "$DIR"/$pattern; do
       [ -f "$bvh" ] || continue
@@ -91,12 +96,15 @@ corpus)
       "$K" -q encode "$bvh" -o "$base.kanim" --error 0.05% || die "encode $bvh"
       "$K" -q decode "$base.kanim" -o "$base.clip.bvh" || die "decode $base.kanim to BVH"
       "$K" decode "$base.kanim" -o "$base.glb" || die "decode $base.kanim to glTF"
+      "$K" decode "$base.kanim" -o "$base.linear.glb" --linear || die "decode $base.kanim to glTF --linear"
       triples+=("$bvh" "$base.clip.bvh" "$base.glb")
+      linear+=("$bvh" "$base.clip.bvh" "$base.linear.glb")
     done
   done
   [ ${#triples[@]} -gt 0 ] || die "no corpus file matches $*"
   node "$CHECK" --percent 0.05 "${triples[@]}" || die "exports fail their checks"
-  echo "$(( ${#triples[@]} / 3 )) corpus exports validated and played within tolerance"
+  node "$CHECK" --percent 0.05 --linear "${linear[@]}" || die "--linear exports fail their checks"
+  echo "$(( ${#triples[@]} / 3 )) corpus files: both exports validated and played within tolerance"
   ;;
 *) die "unknown case $CASE" ;;
 esac

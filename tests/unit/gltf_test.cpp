@@ -308,36 +308,42 @@ TEST_CASE("glTF translations are the clip's curves, between frames too") {
     }
 }
 
-TEST_CASE("glTF rotations stay within the tolerance at every frame, read as slerp or nlerp") {
-  for (double tol : {0.05, 0.005, 0.5}) {
-    CAPTURE(tol);
-    const Clip clip = keyanim::offline::to_clip(test_clip(TangentRule::step_adjusted));
-    GltfOptions o;
-    o.tolerance = tol;
-    GltfReport r;
-    const Glb g = export_glb(clip, o, &r);
-    CHECK(r.tolerance == tol);
-    const double shell = 0.02 * keyanim::offline::skeleton_size(clip.skeleton());
-    CHECK(r.shell_distance == doctest::Approx(shell).epsilon(1e-12));
-    const auto tr = tracks(g);
-    double worst = 0;
-    for (uint32_t f = 0; f < clip.frame_count(); ++f) {
-      const auto want = clip_points(clip, f, shell);
-      for (bool nlerp : {false, true}) {
-        const auto got = gltf_points(g, tr, f * clip.frame_time(), nlerp, shell);
-        REQUIRE(got.size() == want.size());
-        for (size_t p = 0; p < got.size(); ++p)
-          worst = std::max(worst, std::hypot(got[p][0] - want[p][0], got[p][1] - want[p][1], got[p][2] - want[p][2]));
+TEST_CASE("glTF rotations (and --linear translations) stay within the tolerance at every frame, as slerp or nlerp") {
+  for (bool linear_only : {false, true})
+    for (double tol : {0.05, 0.005, 0.5}) {
+      CAPTURE(linear_only);
+      CAPTURE(tol);
+      const Clip clip = keyanim::offline::to_clip(test_clip(TangentRule::step_adjusted));
+      GltfOptions o;
+      o.tolerance = tol;
+      o.linear_only = linear_only;
+      GltfReport r;
+      const Glb g = export_glb(clip, o, &r);
+      CHECK(r.tolerance == tol);
+      const double shell = 0.02 * keyanim::offline::skeleton_size(clip.skeleton());
+      CHECK(r.shell_distance == doctest::Approx(shell).epsilon(1e-12));
+      const auto tr = tracks(g);
+      if (linear_only)
+        for (const auto& [key, t] : tr) CHECK(t.interp == "LINEAR");
+      double worst = 0;
+      for (uint32_t f = 0; f < clip.frame_count(); ++f) {
+        const auto want = clip_points(clip, f, shell);
+        for (bool nlerp : {false, true}) {
+          const auto got = gltf_points(g, tr, f * clip.frame_time(), nlerp, shell);
+          REQUIRE(got.size() == want.size());
+          for (size_t p = 0; p < got.size(); ++p)
+            worst = std::max(worst, std::hypot(got[p][0] - want[p][0], got[p][1] - want[p][1], got[p][2] - want[p][2]));
+        }
       }
+      CHECK(worst <= tol);
+      // The export reports what it reached (its player does not normalise slerp's result).
+      CHECK(std::fabs(worst - r.max_error) <= 1e-6 * keyanim::offline::skeleton_size(clip.skeleton()));
+      CHECK(r.linear_rotation_tracks + r.cubic_rotation_tracks == 5);
+      CHECK(r.translation_tracks == 1);
     }
-    CHECK(worst <= tol);
-    // The export reports what it reached (its player does not normalise slerp's result).
-    CHECK(std::fabs(worst - r.max_error) <= 1e-6 * keyanim::offline::skeleton_size(clip.skeleton()));
-    CHECK(r.linear_rotation_tracks + r.cubic_rotation_tracks == 5);
-  }
 }
 
-TEST_CASE("glTF asset: nodes, hierarchy, names, one animation, a packed buffer; .gltf with its .bin") {
+TEST_CASE("glTF asset: nodes, hierarchy, names, one animation, a packed buffer, and the same as .gltf with its .bin") {
   EncodedClip e = test_clip(TangentRule::step_adjusted);
   e.skeleton.joints[1].name = "Sp\"ine\\ \x01";    // escaped in JSON
   e.skeleton.joints[2].name = "Head \xff\xfe:1";    // not UTF-8: replaced by U+FFFD
@@ -382,7 +388,7 @@ TEST_CASE("glTF asset: nodes, hierarchy, names, one animation, a packed buffer; 
   CHECK(doc == g.doc);
 }
 
-TEST_CASE("glTF: joints at rest get no track; an animation always spans the clip") {
+TEST_CASE("glTF: joints at rest get no track, and an animation always spans the clip") {
   EncodedClip e = test_clip(TangentRule::step_adjusted);
   for (int c : {15, 16, 17}) e.channels[size_t(c)] = chan(Interpolation::cardinal, 0.0f, 1.0, {}, [](double) { return 0.0; });
   const auto tr = tracks(export_glb(keyanim::offline::to_clip(e), {}));
@@ -403,7 +409,7 @@ TEST_CASE("glTF: joints at rest get no track; an animation always spans the clip
   CHECK(st.begin()->second.t == std::vector<float>{0.0f, 2.0f});
 }
 
-TEST_CASE("glTF --fps: LINEAR keys every 1/F s and one at the end; a frame range starts at time 0") {
+TEST_CASE("glTF --fps: LINEAR keys every 1/F s and one at the end, and a frame range starts at time 0") {
   const Clip clip = keyanim::offline::to_clip(test_clip(TangentRule::step_adjusted));
   GltfOptions o;
   o.fps = 7;  // 2 s: keys at 0, 1/7, ..., 14/7 = 2 (the end lands on a key)
@@ -436,7 +442,7 @@ TEST_CASE("glTF --fps: LINEAR keys every 1/F s and one at the end; a frame range
   CHECK(r.worst_frame <= 40);
 }
 
-TEST_CASE("glTF tolerance: the clip's own by default, else 0.05%; refusals") {
+TEST_CASE("glTF tolerance: the clip's own by default, else 0.05%, and refusals") {
   EncodedClip e = test_clip(TangentRule::step_adjusted);
   GltfReport r;
   export_glb(keyanim::offline::to_clip(e), {}, &r);
@@ -482,7 +488,7 @@ TEST_CASE("glTF tolerance: the clip's own by default, else 0.05%; refusals") {
   CHECK(refused(o));
 }
 
-TEST_CASE("glTF: a clip without frames has nodes and no animation; one frame, one key") {
+TEST_CASE("glTF: a clip without frames has nodes and no animation, and one frame has one key") {
   EncodedClip e = test_clip(TangentRule::step_adjusted);
   e.frame_count = 1;
   for (EncodedChannel& c : e.channels)

@@ -12,7 +12,7 @@ namespace keyanim::cli {
 
 const char* const kDecodeHelp =
     "usage: keyanim decode IN.kanim [-o OUT.bvh|OUT.glb|OUT.gltf] [--to bvh|gltf] [--fps F | --inbetweens N]\n"
-    "                      [--frames A:B] [--error E|E%] [-f]\n"
+    "                      [--frames A:B] [--error E|E%] [--linear] [-f]\n"
     "Rebuilds every frame from the keyframes by Cardinal interpolation.\n"
     "  -o, --output FILE     output (default: IN with .bvh, or .glb with --to gltf; '-' = standard output)\n"
     "  --fps F               resample at F frames per second (F > 0; default: the source rate).\n"
@@ -29,16 +29,18 @@ const char* const kDecodeHelp =
     "frame, as a glTF player computes it. With --fps, LINEAR keys every 1/F s instead (the error\n"
     "is reported, not bounded). Time 0 is the first exported frame.\n"
     "  --error E|E%          rotation fit tolerance, length units or percent of the skeleton size\n"
-    "                        (default: the tolerance the clip was encoded with, else 0.05%)\n";
+    "                        (default: the tolerance the clip was encoded with, else 0.05%)\n"
+    "  --linear              LINEAR keys only, translations fitted too: for players that ignore\n"
+    "                        CUBICSPLINE tangents (Blender's glTF importer)\n";
 
 int cmd_decode(const Argv& argv, Globals& g) {
-  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames", "--to", "--error"}, {});
+  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames", "--to", "--error"}, {"--linear"});
   if (args.positional().size() != 1) fail(kUsage, "decode takes one input file");
   const std::string in = args.positional()[0];
   std::string out = args.get("-o").value_or("");
   const bool gltf = wants_gltf(args, out);
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, gltf ? ".glb" : ".bvh");
-  if (args.has("--error") && !gltf) fail(kUsage, "--error applies to glTF output (--to gltf)");
+  if ((args.has("--error") || args.has("--linear")) && !gltf) fail(kUsage, "--error and --linear apply to glTF output");
 
   offline::ResampleOptions opt;
   if (args.has("--fps") && args.has("--inbetweens")) fail(kUsage, "--fps and --inbetweens exclude each other");

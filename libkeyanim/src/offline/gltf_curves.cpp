@@ -71,15 +71,15 @@ bool rotation_at_rest(const NodeCurves& node, const std::vector<ChannelCurve>& c
                      [&](const auto& r) { return curves[size_t(r[1])].constant_at(0.0); });
 }
 
-namespace {
-
-// An axis of a translation: its channel, or its OFFSET component.
-float axis_value(const NodeCurves& node, const std::vector<ChannelCurve>& curves, int axis, double x) {
-  const int32_t c = node.translation[axis];
-  return c >= 0 ? curves[size_t(c)].value(x) : static_cast<float>(node.offset[axis]);
+std::array<float, 3> translation_at(const NodeCurves& node, const std::vector<ChannelCurve>& curves,
+                                    double frame_position) {
+  std::array<float, 3> t;
+  for (size_t a = 0; a < 3; ++a) {
+    const int32_t c = node.translation[a];
+    t[a] = c >= 0 ? curves[size_t(c)].value(frame_position) : static_cast<float>(node.offset[a]);
+  }
+  return t;
 }
-
-}  // namespace
 
 Sampler translation_sampler(const NodeCurves& node, const std::vector<ChannelCurve>& curves, const Window& window) {
   std::vector<uint32_t> knots{window.first, window.last};
@@ -100,8 +100,9 @@ Sampler translation_sampler(const NodeCurves& node, const std::vector<ChannelCur
   for (size_t i = 0; i < knots.size(); ++i) {
     const uint32_t k = knots[i];
     s.times.push_back(static_cast<float>(window.time(k)));
+    const std::array<float, 3> value = translation_at(node, curves, k);
     if (s.interp == Interp::linear) {
-      for (int a = 0; a < 3; ++a) s.values.push_back(axis_value(node, curves, a, k));
+      s.values.insert(s.values.end(), value.begin(), value.end());
       continue;
     }
     // In-tangent, value, out-tangent, per second: a Hermite tangent per frame over frame_time.
@@ -114,7 +115,7 @@ Sampler translation_sampler(const NodeCurves& node, const std::vector<ChannelCur
       if (i + 1 < knots.size()) tangents[1][a] = static_cast<float>(curves[size_t(c)].slope(k, false) / window.frame_time);
     }
     s.values.insert(s.values.end(), tangents[0], tangents[0] + 3);
-    for (int a = 0; a < 3; ++a) s.values.push_back(axis_value(node, curves, a, k));
+    s.values.insert(s.values.end(), value.begin(), value.end());
     s.values.insert(s.values.end(), tangents[1], tangents[1] + 3);
   }
   return s;
@@ -126,7 +127,8 @@ Sampler resampled_translation(const NodeCurves& node, const std::vector<ChannelC
   s.components = 3;
   for (size_t i = 0; i < positions.size(); ++i) {
     s.times.push_back(static_cast<float>(times[i]));
-    for (int a = 0; a < 3; ++a) s.values.push_back(axis_value(node, curves, a, positions[i]));
+    const std::array<float, 3> value = translation_at(node, curves, positions[i]);
+    s.values.insert(s.values.end(), value.begin(), value.end());
   }
   return s;
 }

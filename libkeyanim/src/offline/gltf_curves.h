@@ -50,6 +50,11 @@ NodeCurves node_curves(const Joint& joint);
 bool translation_at_rest(const NodeCurves& node, const std::vector<ChannelCurve>& curves);
 bool rotation_at_rest(const NodeCurves& node, const std::vector<ChannelCurve>& curves);
 
+// The node's translation at a frame position: its channels' values, its OFFSET elsewhere
+// (float32, as samplers store it).
+std::array<float, 3> translation_at(const NodeCurves& node, const std::vector<ChannelCurve>& curves,
+                                    double frame_position);
+
 // The exact translation sampler over the window: keys at the window's ends and at every key of
 // every axis inside it; CUBICSPLINE with one-sided tangents, or LINEAR when every axis is
 // piecewise linear.

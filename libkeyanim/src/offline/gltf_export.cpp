@@ -4,7 +4,7 @@
 #include <sstream>
 
 #include "gltf_curves.h"
-#include "gltf_rotation_fit.h"
+#include "gltf_fit.h"
 #include "gltf_verify.h"
 #include "gltf_writer.h"
 #include "keyanim/offline/decode.h"
@@ -153,8 +153,9 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
           model.nodes[j].rotation = resampled_rotation(nodes[j], curves, positions, times);
       }
     } else {
-      for (size_t j = 0; j < sk.joints.size(); ++j)
-        if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
+      if (!options.linear_only)
+        for (size_t j = 0; j < sk.joints.size(); ++j)
+          if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
       // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result
       // or not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
       const double fit_tol = tol - kRoundingMargin * size;
@@ -163,7 +164,7 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
                 json_number(kRoundingMargin * size) + " (use a larger --error)";
         return false;
       }
-      if (!fit_rotations(model, nodes, curves, reference, fit_tol, report.rounds, error)) return false;
+      if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error)) return false;
     }
     // Every export carries one animation spanning the range, even if nothing moves.
     bool animated = false;

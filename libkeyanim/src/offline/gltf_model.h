@@ -1,7 +1,9 @@
 // The glTF export's in-memory asset, shared by its parts (keyanim/offline/gltf.h):
 //   gltf_curves.cpp  clip channels as curves, translations mapped exactly
 //   gltf_player.cpp  what a glTF player computes from the asset, and its forward kinematics
-//   gltf_rotation_fit.cpp  quaternion keys fitted within the world-space tolerance
+//   gltf_verify.cpp  the clip's forward kinematics against the player's, per point and frame
+//   gltf_fit.cpp     keys fitted within the world-space tolerance (rotations; translations for
+//                    LINEAR-only output)
 //   gltf_writer.cpp  the JSON, the packed buffer and the GLB container
 //   gltf_export.cpp  export_gltf: options, the frame window, putting it together
 #pragma once

@@ -5,7 +5,7 @@
 // What is exact and what is fitted:
 //  - Translations (position channels, and OFFSET components without one) become CUBICSPLINE
 //    (LINEAR where every axis is linear or constant) whose keys are the union of the axes' key
-//    frames. Every Cardinal segment is a cubic, and a cubic split at any time is the same
+//    frames (with linear_only, LINEAR keys fitted like rotations instead). Every Cardinal segment is a cubic, and a cubic split at any time is the same
 //    cubic, so the curve is exactly the clip's: values at key times are the decoder's values
 //    bit for bit; tangents (Hermite tangents over the segment's duration) are rounded once to
 //    float32.
@@ -42,6 +42,10 @@ struct GltfOptions {
   // Defaults to 0: sparse fitted keys. F > 0: LINEAR keys every 1/F s from the range's start,
   // and one at its end, no fit; the error is measured and reported, not bounded.
   double fps = 0.0;
+  // Defaults to false. True: LINEAR keys only, translations fitted within the tolerance like
+  // rotations, for players that ignore CUBICSPLINE tangents (Blender's importer, up to 4.x at
+  // least, puts its own Bezier handles through the keys).
+  bool linear_only = false;
   uint32_t first_frame = 0;          // Defaults to 0: source frames to export (inclusive);
   uint32_t last_frame = UINT32_MAX;  // Defaults to the last frame. Time 0 is first_frame.
   // Defaults to "": a binary .glb. Otherwise a .gltf JSON whose buffer is the file at this URI
