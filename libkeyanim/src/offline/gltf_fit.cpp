@@ -12,8 +12,8 @@ namespace {
 
 constexpr QuatLerp kLocalLerps[] = {QuatLerp::slerp, QuatLerp::nlerp};  // three.js picks one of these per segment
 constexpr uint32_t kMaxRounds = 24;
-constexpr double kTighten = 0.5;     // a blamed track's budget shrinks by this per round
-constexpr double kBlameShare = 0.3;  // tracks moving a stray point by at least this share of the
+constexpr double kTighten = 0.8;     // a blamed track's budget shrinks by this per round
+constexpr double kBlameShare = 0.6;  // tracks moving a stray point by at least this share of the
                                      // largest contribution are blamed
 
 // One node's rotation (k = 4) or translation (k = 3) at every frame of the window.
