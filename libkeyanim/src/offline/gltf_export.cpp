@@ -102,6 +102,63 @@ std::string extras(const GltfReport& r, const Window& w, double fps) {
   return o + "}}";
 }
 
+// The tolerance in length units: the option, else the clip's own, else the encoder's default.
+double tolerance_units(const Clip& clip, const GltfOptions& o, double size) {
+  double tol = o.tolerance_in_percent ? o.tolerance / 100.0 * size : o.tolerance;
+  if (!(tol > 0.0)) tol = note_value(clip.encoder_notes(), "tolerance_units");
+  if (!(tol > 0.0)) tol = kDefaultTolerancePercent / 100.0 * size;
+  return tol;
+}
+
+// The animation: resampled (--fps) or exact translations and fitted keys; then what a player
+// reaches against the clip.
+bool animate(const Clip& clip, const GltfOptions& options, const Window& w, double size, Model& model,
+             GltfReport& report, std::string& error) {
+  const Skeleton& sk = model.skeleton;
+  std::vector<ChannelCurve> curves;
+  for (uint32_t c = 0; c < clip.channel_count(); ++c) curves.emplace_back(clip, c);
+  std::vector<NodeCurves> nodes;
+  for (const Joint& j : sk.joints) nodes.push_back(node_curves(j));
+  const Reference reference(sk, curves, w, report.shell_distance);
+  if (options.fps > 0.0) {
+    std::vector<double> positions, times;
+    if (!resample_positions(w, options.fps, positions, times, error)) return false;
+    for (size_t j = 0; j < sk.joints.size(); ++j) {
+      if (!translation_at_rest(nodes[j], curves))
+        model.nodes[j].translation = resampled_translation(nodes[j], curves, positions, times);
+      if (!nodes[j].rotation.empty() && !rotation_at_rest(nodes[j], curves))
+        model.nodes[j].rotation = resampled_rotation(nodes[j], curves, positions, times);
+    }
+  } else {
+    if (!options.linear_only)
+      for (size_t j = 0; j < sk.joints.size(); ++j)
+        if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
+    const double fit_tol = report.tolerance - kRoundingMargin * size;
+    if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error)) return false;
+  }
+  // Every export carries one animation spanning the range, even if nothing moves.
+  bool animated = false;
+  for (const NodeAnimation& n : model.nodes) animated = animated || n.translation || n.rotation;
+  if (!animated && !sk.joints.empty()) model.nodes[0].translation = translation_sampler(nodes[0], curves, w);
+
+  const CheckResult check = check_model(model, reference, report.tolerance);
+  report.max_error = check.max_error;
+  report.worst_node = reference.owner(check.worst_point);
+  report.worst_axis = reference.moved_by_owner(check.worst_point) ? int(check.worst_point - report.nodes) % 3 : -1;
+  report.worst_frame = w.first + check.worst_frame_index;
+  return true;
+}
+
+void count_tracks(const Model& model, GltfReport& report) {
+  for (const NodeAnimation& n : model.nodes) {
+    if (n.translation) ++report.translation_tracks, report.translation_keys += uint32_t(n.translation->key_count());
+    if (n.rotation) {
+      ++(n.rotation->interp == Interp::cubic ? report.cubic_rotation_tracks : report.linear_rotation_tracks);
+      report.rotation_keys += uint32_t(n.rotation->key_count());
+    }
+  }
+}
+
 }  // namespace
 
 bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
@@ -114,76 +171,29 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
   Model model;
   model.skeleton = clip.skeleton();
   model.animation_name = options.name;
-  const Skeleton& sk = model.skeleton;
-  model.nodes.resize(sk.joints.size());
-  report.nodes = uint32_t(sk.joints.size());
-
-  // Per frame and node of the window: reference points, rotation targets.
-  const double working = double(w.frames()) * double(sk.joints.size()) * (4 * sizeof(Vec3) + 96);
+  model.nodes.resize(model.skeleton.joints.size());
+  report.nodes = uint32_t(model.nodes.size());
+  // Per frame and node of the window: reference points, fit targets.
+  const double working = double(w.frames()) * double(report.nodes) * (4 * sizeof(Vec3) + 96);
   if (!(working <= kMaxWorkingBytes)) {
     error = "the clip is too long for one glTF export (" + std::to_string(w.frames()) + " frames of " +
-            std::to_string(sk.joints.size()) + " nodes): export it in frame ranges";
+            std::to_string(report.nodes) + " nodes): export it in frame ranges";
     return false;
   }
   const double size = reference_size(clip);
-  double tol = options.tolerance_in_percent ? options.tolerance / 100.0 * size : options.tolerance;
-  if (!(tol > 0.0)) tol = note_value(clip.encoder_notes(), "tolerance_units");
-  if (!(tol > 0.0)) tol = kDefaultTolerancePercent / 100.0 * size;
-  if (!(tol > 0.0) && clip.frame_count() > 0) {
-    error = "the tolerance is 0 (the skeleton has no size): give one in length units";
+  report.tolerance = tolerance_units(clip, options, size);
+  report.shell_distance = options.shell_percent / 100.0 * size;
+  // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result or
+  // not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
+  if (clip.frame_count() > 0 && options.fps == 0.0 && !(report.tolerance > kRoundingMargin * size)) {
+    error = report.tolerance > 0.0
+                ? "float32 glTF keys cannot hold the tolerance " + json_number(report.tolerance) +
+                      ": rounding alone reaches " + json_number(kRoundingMargin * size) + " (use a larger --error)"
+                : "the tolerance is 0 (the skeleton has no extent): give one in length units with --error";
     return false;
   }
-  report.tolerance = tol;
-  report.shell_distance = options.shell_percent / 100.0 * size;
-
-  if (clip.frame_count() > 0) {
-    std::vector<ChannelCurve> curves;
-    for (uint32_t c = 0; c < clip.channel_count(); ++c) curves.emplace_back(clip, c);
-    std::vector<NodeCurves> nodes;
-    for (const Joint& j : sk.joints) nodes.push_back(node_curves(j));
-    const Reference reference(sk, curves, w, report.shell_distance);
-
-    if (options.fps > 0.0) {
-      std::vector<double> positions, times;
-      if (!resample_positions(w, options.fps, positions, times, error)) return false;
-      for (size_t j = 0; j < sk.joints.size(); ++j) {
-        if (!translation_at_rest(nodes[j], curves))
-          model.nodes[j].translation = resampled_translation(nodes[j], curves, positions, times);
-        if (!nodes[j].rotation.empty() && !rotation_at_rest(nodes[j], curves))
-          model.nodes[j].rotation = resampled_rotation(nodes[j], curves, positions, times);
-      }
-    } else {
-      if (!options.linear_only)
-        for (size_t j = 0; j < sk.joints.size(); ++j)
-          if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
-      // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result
-      // or not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
-      const double fit_tol = tol - kRoundingMargin * size;
-      if (!(fit_tol > 0.0)) {
-        error = "float32 glTF keys cannot hold the tolerance " + json_number(tol) + ": rounding alone reaches " +
-                json_number(kRoundingMargin * size) + " (use a larger --error)";
-        return false;
-      }
-      if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error)) return false;
-    }
-    // Every export carries one animation spanning the range, even if nothing moves.
-    bool animated = false;
-    for (const NodeAnimation& n : model.nodes) animated = animated || n.translation || n.rotation;
-    if (!animated && !sk.joints.empty()) model.nodes[0].translation = translation_sampler(nodes[0], curves, w);
-
-    const CheckResult check = check_model(model, reference, tol);
-    report.max_error = check.max_error;
-    report.worst_node = reference.owner(check.worst_point);
-    report.worst_axis = reference.moved_by_owner(check.worst_point) ? int(check.worst_point - report.nodes) % 3 : -1;
-    report.worst_frame = w.first + check.worst_frame_index;
-  }
-  for (const NodeAnimation& n : model.nodes) {
-    if (n.translation) ++report.translation_tracks, report.translation_keys += uint32_t(n.translation->key_count());
-    if (n.rotation) {
-      ++(n.rotation->interp == Interp::cubic ? report.cubic_rotation_tracks : report.linear_rotation_tracks);
-      report.rotation_keys += uint32_t(n.rotation->key_count());
-    }
-  }
+  if (clip.frame_count() > 0 && !animate(clip, options, w, size, model, report, error)) return false;
+  count_tracks(model, report);
   model.extras_json = extras(report, w, options.fps);
   if (options.bin_uri.empty()) out.main = write_glb(model);
   else write_gltf(model, options.bin_uri, out.main, out.bin);
