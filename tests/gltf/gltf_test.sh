@@ -38,12 +38,12 @@ cli)
   # By extension: .glb, and .gltf with its .bin; --to gltf names the output IN.glb.
   expect_rc 0 "$K" decode walk.kanim -o walk.glb
   grep -q 'walk.kanim -> walk.glb: .* error max .* tolerance' .stderr || die "no summary: $(cat .stderr)"
-  expect_rc 0 "$K" decode walk.kanim -o split.gltf
-  [ -s split.bin ] || die ".gltf output wrote no split.bin"
-  grep -q '"uri":"split.bin"' split.gltf || die "split.gltf does not reference split.bin"
+  expect_rc 0 "$K" decode walk.kanim -o "split walk.gltf"
+  [ -s "split walk.bin" ] || die ".gltf output wrote no .bin"
+  grep -q '"uri":"split%20walk.bin"' "split walk.gltf" || die "the .gltf does not reference its .bin as a URI"
   expect_rc 0 "$K" decode hop.kanim --to gltf
   [ -s hop.glb ] || die "--to gltf did not write hop.glb"
-  node "$CHECK" "$WALK" walk.bvh walk.glb "$WALK" walk.bvh split.gltf "$HOP" hop.bvh hop.glb || die "exports fail their checks"
+  node "$CHECK" "$WALK" walk.bvh walk.glb "$WALK" walk.bvh "split walk.gltf" "$HOP" hop.bvh hop.glb || die "exports fail their checks"
   # To standard output: a GLB, the same bytes as the file.
   "$K" decode walk.kanim --to gltf -o - >stdout.glb || die "decode to standard output"
   cmp -s stdout.glb walk.glb || die "standard output differs from the .glb"

@@ -18,6 +18,20 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// A file name as a relative URI reference (RFC 3986): bytes other than unreserved ones are
+// percent-encoded, so that "my walk.bin" becomes "my%20walk.bin".
+std::string uri_of_file_name(const std::string& name) {
+  static const char kHex[] = "0123456789ABCDEF";
+  std::string o;
+  for (unsigned char c : name) {
+    const bool unreserved = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                            c == '-' || c == '.' || c == '_' || c == '~';
+    if (unreserved) o += char(c);
+    else o += {'%', kHex[c >> 4], kHex[c & 15]};
+  }
+  return o;
+}
+
 std::string point_name(const Skeleton& s, const offline::GltfReport& r) {
   std::string name = node_name(s, r.worst_node);
   if (r.worst_axis >= 0) name += std::string(" +") + "xyz"[r.worst_axis] + " shell";
@@ -55,7 +69,7 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
   const std::string bin_path = split ? swap_extension(out, ".bin") : "";
   std::optional<Output> bin;
   if (split) {
-    o.bin_uri = std::filesystem::path(bin_path).filename().string();
+    o.bin_uri = uri_of_file_name(std::filesystem::path(bin_path).filename().string());
     bin.emplace(bin_path, true, g, ids_of({&input}));
   }
   Output main(out, !split, g, ids_of({&input}));
