@@ -21,7 +21,8 @@ export function readBvh(path) {
     const head = words[0];
     if (head === 'ROOT' || head === 'JOINT' || head === 'End') {
       const endSite = head === 'End';
-      const name = endSite ? '' : line.slice(head.length).trim().replace(/\s*\{$/, '');
+      // A name is the rest of the line (End Sites: after "End Site", usually nothing).
+      const name = line.slice(endSite ? line.indexOf('Site') + 4 : head.length).trim().replace(/\s*\{$/, '');
       pending = { name, parent: stack.length ? stack[stack.length - 1] : -1, offset: [0, 0, 0], channels: [], endSite, first: 0 };
       nodes.push(pending);
       if (line.endsWith('{')) { stack.push(nodes.length - 1); pending = null; }
@@ -132,7 +133,7 @@ export function pointName(bvh, p) {
   const n = bvh.nodes.length;
   if (p < n) {
     const node = bvh.nodes[p];
-    return node.endSite ? `End Site of ${bvh.nodes[node.parent].name}` : node.name;
+    return node.endSite && !node.name ? `End Site of ${bvh.nodes[node.parent].name}` : node.name;
   }
   const joints = bvh.nodes.map((x, j) => j).filter((j) => !bvh.nodes[j].endSite);
   const k = p - n;

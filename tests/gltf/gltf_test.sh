@@ -2,7 +2,7 @@
 # glTF export, checked by tools that share no code with keyanim (check_export.mjs: the Khronos
 # glTF-Validator, three.js playing the export, BVH forward kinematics written in JS).
 #   gltf_test.sh KEYANIM DATA_DIR cli            the command's behaviour on the shipped clips
-#   gltf_test.sh KEYANIM CORPUS_DIR corpus FILE_GLOB...  every matching corpus file: encode at
+#   gltf_test.sh KEYANIM CORPUS_DIR corpus FILE_GLOB...  every matching file of the folder: encode at
 #                                                0.05%, export with the defaults and with
 #                                                --linear, check both
 # Needs node and this folder's node_modules (scripts/install-deps.sh: npm ci). Exits 77
@@ -104,7 +104,7 @@ corpus)
   [ ${#triples[@]} -gt 0 ] || die "no corpus file matches $*"
   node "$CHECK" --percent 0.05 "${triples[@]}" || die "exports fail their checks"
   node "$CHECK" --percent 0.05 --linear "${linear[@]}" || die "--linear exports fail their checks"
-  echo "$(( ${#triples[@]} / 3 )) corpus files: both exports validated and played within tolerance"
+  echo "$(( ${#triples[@]} / 3 )) files: both exports validated and played within tolerance"
   ;;
 *) die "unknown case $CASE" ;;
 esac
