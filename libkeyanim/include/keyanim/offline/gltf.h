@@ -5,10 +5,10 @@
 // What is exact and what is fitted:
 //  - Translations (position channels, and OFFSET components without one) become CUBICSPLINE
 //    (LINEAR where every axis is linear or constant) whose keys are the union of the axes' key
-//    frames (with linear_only, LINEAR keys fitted like rotations instead). Every Cardinal segment is a cubic, and a cubic split at any time is the same
+//    frames. Every Cardinal segment is a cubic, and a cubic split at any time is the same
 //    cubic, so the curve is exactly the clip's: values at key times are the decoder's values
 //    bit for bit; tangents (Hermite tangents over the segment's duration) are rounded once to
-//    float32.
+//    float32. With linear_only, LINEAR keys are fitted instead, like rotations.
 //  - Rotations: Euler curves are not quaternion splines, so quaternion keys are fitted (LINEAR,
 //    or CUBICSPLINE where fewer bytes) until forward kinematics of what a glTF player computes
 //    stays within the tolerance of the clip's own forward kinematics at every source frame, for
@@ -30,21 +30,23 @@
 namespace keyanim::offline {
 
 struct GltfOptions {
-  // World-space tolerance of the rotation fit, in file length units, or in percent of the
+  // World-space tolerance of the fit, in file length units, or in percent of the
   // skeleton size with tolerance_in_percent. Defaults to 0: the tolerance the clip was encoded
   // with (its encoder note tolerance_units), or 0.05% of the skeleton size (the encoder's
   // default) when the clip has no such note.
   double tolerance = 0.0;
   bool tolerance_in_percent = false;  // Defaults to false.
-  // Shell points at this percent of the skeleton size (largest side of the rest-pose box).
+  // Shell points at this percent of the skeleton size (the size percentages are of: the largest
+  // side of the rest-pose box, or of the box a skeleton without extent sweeps, as encode.h's
+  // reference_size).
   // Defaults to 2 (the project's shell metric); 0 measures joints and End Sites only.
   double shell_percent = 2.0;
   // Defaults to 0: sparse fitted keys. F > 0: LINEAR keys every 1/F s from the range's start,
   // and one at its end, no fit; the error is measured and reported, not bounded.
   double fps = 0.0;
   // Defaults to false. True: LINEAR keys only, translations fitted within the tolerance like
-  // rotations, for players that ignore CUBICSPLINE tangents (Blender's importer, up to 4.x at
-  // least, puts its own Bezier handles through the keys).
+  // rotations, for players that ignore CUBICSPLINE tangents (Blender 3.4's importer keeps the
+  // key values and lays its own Bezier handles through them).
   bool linear_only = false;
   uint32_t first_frame = 0;          // Defaults to 0: source frames to export (inclusive);
   uint32_t last_frame = UINT32_MAX;  // Defaults to the last frame. Time 0 is first_frame.
@@ -55,7 +57,7 @@ struct GltfOptions {
 };
 
 struct GltfReport {
-  double tolerance = 0.0;       // what rotations were fitted within, file length units
+  double tolerance = 0.0;       // what keys were fitted within, file length units
   double shell_distance = 0.0;  // file length units (0: no shell points)
   // Largest distance, over the source frames of the range and every joint, End Site and shell
   // point, between the clip's forward kinematics and a glTF player's (the worse of slerp and
@@ -67,7 +69,7 @@ struct GltfReport {
   uint32_t nodes = 0;
   uint32_t translation_tracks = 0, translation_keys = 0;
   uint32_t linear_rotation_tracks = 0, cubic_rotation_tracks = 0, rotation_keys = 0;
-  uint32_t rounds = 0;          // verification rounds of the rotation fit
+  uint32_t rounds = 0;          // verification rounds of the fit (0 with fps)
 };
 
 struct GltfOutput {
@@ -78,7 +80,8 @@ struct GltfOutput {
 // Builds the asset. Returns false (and says why in `error`, `out` left empty) for options that
 // make no sense (tolerance or fps not positive and finite, shell_percent negative, an empty or
 // reversed frame range, last_frame beyond the clip), a clip whose frame time is not positive
-// while it has several frames, or a tolerance that float32 keys cannot hold.
+// while it has several frames, a tolerance that float32 keys cannot hold, or a range too long
+// for one asset (working memory above 1 GiB, more than 2^24 resampled keys, 4 GiB of output).
 bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
                  std::string& error);
 
