@@ -28,8 +28,8 @@ const char* const kDecodeHelp =
     "the skeleton size along each joint's axes) stays within --error of the clip at every source\n"
     "frame, as a glTF player computes it. With --fps, LINEAR keys every 1/F s instead (the error\n"
     "is reported, not bounded). Time 0 is the first exported frame.\n"
-    "  --error E|E%          rotation fit tolerance, length units or percent of the skeleton size\n"
-    "                        (default: the tolerance the clip was encoded with, else 0.05%)\n"
+    "  --error E|E%          the fit's world-space tolerance, length units or percent of the skeleton\n"
+    "                        size (default: the tolerance the clip was encoded with, else 0.05%)\n"
     "  --linear              LINEAR keys only, translations fitted too: for players that ignore\n"
     "                        CUBICSPLINE tangents (Blender's glTF importer)\n";
 
