@@ -10,6 +10,7 @@
 #   (glTF-Blender-IO issue 419), so it does not play them as the glTF specification says.
 set -uo pipefail
 HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+NODE_DIR=${KEYANIM_GLTF_NODE_DIR:-$HERE}  # blender_compare.mjs beside its node_modules (gltf_test.sh)
 K=$(realpath "$1"); shift
 command -v blender >/dev/null || { echo "blender not found: Blender check skipped"; exit 77; }
 T=$(mktemp -d)
@@ -28,7 +29,7 @@ for bvh in "$@"; do
     blender -b --factory-startup --python-exit-code 1 --python "$HERE/blender_play.py" -- \
       "$glb" "$frames" "$ft" "$glb.json" >"$T/blender.log" 2>&1 ||
       { cat "$T/blender.log"; echo "FAIL: Blender on $glb"; status=1; continue; }
-    if ! node "$HERE/blender_compare.mjs" "$base.clip.bvh" "$glb" "$glb.json" && [ $mode = linear ]; then
+    if ! node "$NODE_DIR/blender_compare.mjs" "$base.clip.bvh" "$glb" "$glb.json" && [ $mode = linear ]; then
       status=1
     fi
   done
