@@ -10,7 +10,9 @@
 // Elementary rotations are the right-handed ones: Rx(a) = [1 0 0; 0 c -s; 0 s c],
 // Ry(a) = [c 0 s; 0 1 0; -s 0 c], Rz(a) = [c -s 0; s c 0; 0 0 1].
 // Sine and cosine are computed after reducing the angle to the nearest multiple of 90 degrees,
-// so multiples of 90 are exact and an angle and the same angle +-360 give the same pose.
+// so multiples of 90 are exact and an angle and the same angle +-360 give the same pose; the
+// reduced angle goes through fdlibm's kernels (within 1 ulp), not the platform's libm, so FK
+// gives the same bits on every platform.
 //
 // Nodes must be stored parents first (parent < own index) and first_channel must be assigned
 // (Skeleton::assign_channel_columns); a node whose parent index is not smaller than its own is
