@@ -5,91 +5,107 @@
 #include <optional>
 
 namespace keyanim::offline {
-CurveFit::CurveFit(const std::vector<double>& y, Interpolation interp, float s, TangentRule rule)
-    : y_(&y), interp_(interp), s_(s), rule_(rule) {}
 
-void CurveFit::reset(const std::vector<uint32_t>& keys, const std::vector<double>& tol, double step) {
-  tol_ = &tol;
-  step_ = step;
-  const size_t n = y_->size();
-  prev_.assign(n, kNone), next_.assign(n, kNone), is_key_.assign(n, 0);
-  q_.assign(n, 0), v_.assign(n, 0.0f), seg_ratio_.assign(n, 0.0), seg_arg_.assign(n, 0);
+int64_t quantize(double y, double step) noexcept { return std::llround(y / step); }
+
+void FitScratch::prepare(size_t frames) {
+  if (prev.size() == frames) return;
+  prev.assign(frames, CurveFit::kNone), next.assign(frames, CurveFit::kNone), is_key.assign(frames, 0);
+  q.assign(frames, 0), v.assign(frames, 0.0f), seg_ratio.assign(frames, 0.0), seg_arg.assign(frames, 0);
+}
+
+CurveFit::CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule,
+                   FitScratch& scratch)
+    : y_(y), frames_(frames), interp_(interp), s_(s), rule_(rule), w_(scratch) {
+  w_.prepare(frames);
+}
+
+CurveFit::~CurveFit() {
+  // Unlinking as we go leaves every frame as prepare() made it.
+  for (uint32_t f = first_; f != kNone;) {
+    const uint32_t next = w_.next[f];
+    w_.prev[f] = w_.next[f] = kNone, w_.is_key[f] = 0;
+    f = next;
+  }
+}
+
+void CurveFit::link_keys(const std::vector<uint32_t>& keys) {
   first_ = keys.empty() ? kNone : keys.front();
   count_ = keys.size();
-  recent_.clear();
-  prune_all_ = true;
   for (size_t i = 0; i < keys.size(); ++i) {
     const uint32_t f = keys[i];
-    is_key_[f] = 1;
-    prev_[f] = i > 0 ? keys[i - 1] : kNone;
-    next_[f] = i + 1 < keys.size() ? keys[i + 1] : kNone;
-    quantize(f);
+    w_.is_key[f] = 1;
+    w_.prev[f] = i > 0 ? keys[i - 1] : kNone;
+    w_.next[f] = i + 1 < keys.size() ? keys[i + 1] : kNone;
+    quantize_at(f);
   }
+}
+
+void CurveFit::reset(const std::vector<uint32_t>& keys, Tolerance tol, double step) {
+  tol_ = tol;
+  step_ = step;
+  recent_.clear();
+  prune_all_ = true;
+  link_keys(keys);
   measure_all();
 }
 
-void CurveFit::retarget(const std::vector<double>& tol, double step, const std::vector<uint32_t>* changed) {
-  tol_ = &tol;
-  if (step != step_ || !changed) {
-    if (step != step_) {
-      step_ = step;
-      for (uint32_t f = first_; f != kNone; f = next_[f]) quantize(f);
-    }
-    measure_all();
-    return;
-  }
+void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double step, double previous_step,
+                      const std::vector<uint32_t>* changed) {
+  tol_ = tol;
+  step_ = step;
+  recent_.clear();
+  prune_all_ = false;
+  link_keys(keys);  // quantized at the current step: a changed step requantizes every key
+  if (step != previous_step || !changed) return measure_all();
+  // Every other segment was within its (unchanged) tolerance when the last fit ended.
   uint32_t last = kNone;  // changed frames are sorted: measure each segment once
   for (uint32_t f : *changed) {
     uint32_t s = f;
-    while (s != 0 && !is_key_[s]) --s;
-    if (s == f && is_key_[f] && f != first_) s = prev_[f];  // a key's tolerance bounds its neighbours' fits
-    if (s == last || next_[s] == kNone) continue;
+    while (s != 0 && !w_.is_key[s]) --s;
+    if (s == f && w_.is_key[f] && f != first_) s = w_.prev[f];  // a key's tolerance bounds its neighbours' fits
+    if (s == last || w_.next[s] == kNone) continue;
     measure(s);
     last = s;
   }
 }
 
-void CurveFit::quantize(uint32_t f) {
-  q_[f] = std::llround((*y_)[f] / step_);
-  v_[f] = dequantize(q_[f], step_);
+void CurveFit::quantize_at(uint32_t f) {
+  w_.q[f] = quantize(y_[f], step_);
+  w_.v[f] = dequantize(w_.q[f], step_);
 }
 
 void CurveFit::measure_all() {
   heap_ = {};
-  for (uint32_t f = first_; f != kNone && next_[f] != kNone; f = next_[f]) measure(f);
+  for (uint32_t f = first_; f != kNone && w_.next[f] != kNone; f = w_.next[f]) measure(f);
 }
 
 void CurveFit::measure(uint32_t start, bool push) {
   // The decoder's arithmetic on the (up to) four keys around the segment [start, end]: the
   // same end-point duplication as eval_segment applies where the list ends.
-  const uint32_t end = next_[start];
-  uint32_t frames[4];
-  float values[4];
-  uint32_t n = 0, j = 0;
-  if (prev_[start] != kNone) frames[n] = prev_[start], values[n++] = v_[prev_[start]], j = 1;
-  frames[n] = start, values[n++] = v_[start];
-  frames[n] = end, values[n++] = v_[end];
-  if (next_[end] != kNone) frames[n] = next_[end], values[n++] = v_[next_[end]];
-  const SegmentOperands ops = segment_operands(frames, values, n, j, interp_, s_, rule_);
+  const uint32_t end = w_.next[start], p = w_.prev[start], n = w_.next[end];
+  const Key before{p, p != kNone ? w_.v[p] : 0.0f}, after{n, n != kNone ? w_.v[n] : 0.0f};
+  const SegmentOperands ops = operands_between(p != kNone ? &before : nullptr, {start, w_.v[start]},
+                                               {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
   double worst = 0.0;
   uint32_t arg = start + 1;
   for (uint32_t f = start + 1; f < end; ++f) {
     const float v = eval_operands(ops, segment_u(start, end, float(f)));
-    const double r = std::fabs(double(v) - (*y_)[f]) / (*tol_)[f];
+    const double r = std::fabs(double(v) - y_[f]) / tol_.at(f);
     if (r > worst) worst = r, arg = f;
   }
-  seg_ratio_[start] = worst, seg_arg_[start] = arg;
+  w_.seg_ratio[start] = worst, w_.seg_arg[start] = arg;
   if (push && worst > 1.0) heap_.push({worst, start, end});
 }
 
 void CurveFit::link(uint32_t f, uint32_t a, uint32_t b) {
-  is_key_[f] = 1, prev_[f] = a, next_[f] = b, next_[a] = f, prev_[b] = f;
+  w_.is_key[f] = 1, w_.prev[f] = a, w_.next[f] = b, w_.next[a] = f, w_.prev[b] = f;
   ++count_;
 }
 
 void CurveFit::unlink(uint32_t f) {
-  const uint32_t a = prev_[f], b = next_[f];
-  next_[a] = b, prev_[b] = a, is_key_[f] = 0, prev_[f] = next_[f] = kNone;
+  const uint32_t a = w_.prev[f], b = w_.next[f];
+  w_.next[a] = b, w_.prev[b] = a, w_.is_key[f] = 0, w_.prev[f] = w_.next[f] = kNone;
   --count_;
 }
 
@@ -97,24 +113,24 @@ void CurveFit::refine() {
   while (!heap_.empty()) {
     const Entry e = heap_.top();
     heap_.pop();
-    if (!is_key_[e.start] || next_[e.start] != e.end || seg_ratio_[e.start] != e.ratio) continue;  // stale
+    if (!w_.is_key[e.start] || w_.next[e.start] != e.end || w_.seg_ratio[e.start] != e.ratio) continue;  // stale
     if (e.ratio <= 1.0) continue;
     // A new key changes the four segments whose window holds it: [p, a], [a, f], [f, b], [b, c].
-    const uint32_t a = e.start, b = e.end, f = seg_arg_[a];
-    quantize(f);
+    const uint32_t a = e.start, b = e.end, f = w_.seg_arg[a];
+    quantize_at(f);
     link(f, a, b);
     recent_.push_back(f);
-    if (prev_[a] != kNone) measure(prev_[a]);
+    if (w_.prev[a] != kNone) measure(w_.prev[a]);
     measure(a), measure(f);
-    if (next_[b] != kNone) measure(b);
+    if (w_.next[b] != kNone) measure(b);
   }
 }
 
 void CurveFit::prune() {
   if (first_ == kNone) return;
   if (prune_all_) {
-    for (uint32_t f = next_[first_]; f != kNone && next_[f] != kNone;) {
-      const uint32_t b = next_[f];
+    for (uint32_t f = w_.next[first_]; f != kNone && w_.next[f] != kNone;) {
+      const uint32_t b = w_.next[f];
       try_remove(f);
       f = b;
     }
@@ -122,10 +138,10 @@ void CurveFit::prune() {
   } else {
     // Only keys near the new ones can have become unnecessary.
     for (uint32_t f : recent_) {
-      if (!is_key_[f]) continue;
-      const uint32_t a = prev_[f], b = next_[f];
+      if (!w_.is_key[f]) continue;
+      const uint32_t a = w_.prev[f], b = w_.next[f];
       for (uint32_t g : {a, f, b})
-        if (g != kNone && is_key_[g] && g != first_ && next_[g] != kNone) try_remove(g);
+        if (g != kNone && w_.is_key[g] && g != first_ && w_.next[g] != kNone) try_remove(g);
     }
   }
   recent_.clear();
@@ -134,31 +150,34 @@ void CurveFit::prune() {
 // Removes interior key f if every segment it affects stays within tolerance without it.
 bool CurveFit::try_remove(uint32_t f) {
   // Without f, the segments starting at p = prev(a), a and b change; f's own disappears.
-  const uint32_t a = prev_[f], b = next_[f], p = prev_[a];
+  const uint32_t a = w_.prev[f], b = w_.next[f], p = w_.prev[a];
   const uint32_t starts[4] = {p, a, f, b};
   double ratios[4];
   uint32_t args[4];
   for (int t = 0; t < 4; ++t)
-    if (starts[t] != kNone) ratios[t] = seg_ratio_[starts[t]], args[t] = seg_arg_[starts[t]];
+    if (starts[t] != kNone) ratios[t] = w_.seg_ratio[starts[t]], args[t] = w_.seg_arg[starts[t]];
   unlink(f);
   bool ok = true;
   for (uint32_t s : {p, a, b}) {
-    if (!ok || s == kNone || next_[s] == kNone) continue;
+    if (!ok || s == kNone || w_.next[s] == kNone) continue;
     measure(s, false);  // on success every ratio is <= 1: nothing for the heap
-    ok = seg_ratio_[s] <= 1.0;
+    ok = w_.seg_ratio[s] <= 1.0;
   }
   if (ok) return true;
   link(f, a, b);
   for (int t = 0; t < 4; ++t)
-    if (starts[t] != kNone) seg_ratio_[starts[t]] = ratios[t], seg_arg_[starts[t]] = args[t];
+    if (starts[t] != kNone) w_.seg_ratio[starts[t]] = ratios[t], w_.seg_arg[starts[t]] = args[t];
   return false;
 }
 
 float CurveFit::best_s() const {
   double num = 0.0, den = 0.0;
-  for (uint32_t a = first_; a != kNone && next_[a] != kNone; a = next_[a]) {
-    const uint32_t b = next_[a], pm = prev_[a] != kNone ? prev_[a] : a, c = next_[b] != kNone ? next_[b] : b;
-    const double p0 = v_[a], p1 = v_[b], vm = v_[pm], p2 = v_[c];
+  const auto& next = w_.next;
+  const auto& prev = w_.prev;
+  const auto& val = w_.v;
+  for (uint32_t a = first_; a != kNone && next[a] != kNone; a = next[a]) {
+    const uint32_t b = next[a], pm = prev[a] != kNone ? prev[a] : a, c = next[b] != kNone ? next[b] : b;
+    const double p0 = val[a], p1 = val[b], vm = val[pm], p2 = val[c];
     double a0 = 1.0, a1 = 1.0;
     const double len = b - a;
     if (rule_ == TangentRule::step_adjusted) {
@@ -169,7 +188,7 @@ float CurveFit::best_s() const {
       const double u = (f - a) / len, u2 = u * u, u3 = u2 * u;
       const double base = (2 * u3 - 3 * u2 + 1) * p0 + (-2 * u3 + 3 * u2) * p1;
       const double slope = (u3 - 2 * u2 + u) * a0 * (p1 - vm) + (u3 - u2) * a1 * (p2 - p0);
-      num += slope * ((*y_)[f] - base);
+      num += slope * (y_[f] - base);
       den += slope * slope;
     }
   }
@@ -177,13 +196,11 @@ float CurveFit::best_s() const {
   return float(std::clamp(num / den, 0.0, 1.0));
 }
 
-EncodedChannel CurveFit::result(float tension) const {
-  EncodedChannel ch;
-  ch.interp = interp_;
-  ch.tension = tension;
-  ch.step = step_;
-  for (uint32_t f = first_; f != kNone; f = next_[f]) ch.frames.push_back(f), ch.q.push_back(q_[f]);
-  return ch;
+std::vector<uint32_t> CurveFit::keys() const {
+  std::vector<uint32_t> out;
+  out.reserve(count_);
+  for (uint32_t f = first_; f != kNone; f = w_.next[f]) out.push_back(f);
+  return out;
 }
 
 namespace {
@@ -194,69 +211,93 @@ std::vector<uint32_t> end_keys(size_t frames) {
   return {0, uint32_t(frames - 1)};
 }
 
+EncodedChannel channel_at(const double* y, Interpolation interp, float tension, double step,
+                          std::vector<uint32_t> keys) {
+  EncodedChannel ch;
+  ch.interp = interp;
+  ch.tension = tension;
+  ch.step = step;
+  ch.q.resize(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) ch.q[i] = quantize(y[keys[i]], step);
+  ch.frames = std::move(keys);
+  return ch;
+}
+
 }  // namespace
 
-std::optional<EncodedChannel> constant_channel(const std::vector<double>& y, const std::vector<double>& tol,
-                                               double step) {
+std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames, double lo, double hi,
+                                               Tolerance tol, double step) {
   EncodedChannel ch;
   ch.step = step;
-  if (y.empty()) return ch;
-  const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
-  const int64_t q = std::llround(0.5 * (*lo + *hi) / step);
+  if (frames == 0) return ch;
+  const int64_t q = quantize(0.5 * (lo + hi), step);
   const float v = dequantize(q, step);
-  for (size_t f = 0; f < y.size(); ++f)
-    if (!(std::fabs(double(v) - y[f]) <= tol[f])) return std::nullopt;
+  for (uint32_t f = 0; f < frames; ++f)
+    if (!(std::fabs(double(v) - y[f]) <= tol.at(f))) return std::nullopt;
   if (q != 0) ch.frames = {0}, ch.q = {q};
   return ch;
 }
 
-EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys,
-                                   const std::vector<double>& tol, double step, const ChannelFitOptions& opt) {
-  if (auto c = constant_channel(y, tol, step)) return *c;
+EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys, Tolerance tol,
+                                   double step, const ChannelFitOptions& opt, FitScratch& scratch) {
+  const uint32_t n = uint32_t(y.size());
+  if (n > 0) {
+    const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
+    if (auto c = constant_channel(y.data(), n, *lo, *hi, tol, step)) return *c;
+  }
   const Interpolation interp = opt.force_linear ? Interpolation::linear : Interpolation::cardinal;
-  CurveFit curve(y, interp, tension_to_s(opt.tension), opt.rule);
-  curve.reset(keys, tol, step);
-  if (!opt.fit_tension || opt.force_linear) return curve.result(opt.tension);
-  const float t = s_to_tension(curve.best_s());
-  CurveFit fitted(y, interp, tension_to_s(t), opt.rule);
-  fitted.reset(keys, tol, step);
-  return fitted.result(t);
+  float tension = opt.tension;
+  if (opt.fit_tension && !opt.force_linear) {
+    CurveFit curve(y.data(), n, interp, tension_to_s(opt.tension), opt.rule, scratch);
+    curve.reset(keys, tol, step);
+    tension = s_to_tension(curve.best_s());
+  }
+  return channel_at(y.data(), interp, tension, step, keys);
 }
 
-ChannelFitter::ChannelFitter(const std::vector<double>& y, const ChannelFitOptions& options)
-    : y_(&y), opt_(options) {}
-
-EncodedChannel ChannelFitter::fit(const std::vector<double>& tol, double step, const std::vector<uint32_t>* changed) {
-  if (auto c = constant_channel(*y_, tol, step)) return *c;
+EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<uint32_t>* changed,
+                                  FitScratch& scratch) {
+  const double* y = scratch.y.data();
+  const uint32_t n = uint32_t(scratch.y.size());
+  if (!have_extent_ && n > 0) {
+    const auto [lo, hi] = std::minmax_element(scratch.y.begin(), scratch.y.end());
+    lo_ = *lo, hi_ = *hi, have_extent_ = true;
+  }
+  if (auto c = constant_channel(y, n, lo_, hi_, tol, step)) return *c;
   if (candidates_.empty()) {
-    const std::vector<uint32_t> ends = end_keys(y_->size());
-    auto add = [&](Interpolation interp, float tension) {
-      candidates_.emplace_back(*y_, interp, tension_to_s(tension), opt_.rule);
-      tensions_.push_back(tension);
-      CurveFit& c = candidates_.back();
+    const std::vector<uint32_t> ends = end_keys(n);
+    auto add = [&](Interpolation interp, float tension, float* best_s = nullptr) {
+      CurveFit c(y, n, interp, tension_to_s(tension), opt_.rule, scratch);
       c.reset(ends, tol, step);
       c.refine();
       c.prune();
+      if (best_s) *best_s = c.best_s();
+      candidates_.push_back({interp, tension, step, c.keys()});
     };
     if (opt_.force_linear) {
       add(Interpolation::linear, opt_.tension);
     } else {
-      add(Interpolation::cardinal, opt_.tension);
       // A fitted tension is kept only if it ends up cheaper (checked at every fit below).
-      if (opt_.fit_tension) add(Interpolation::cardinal, s_to_tension(candidates_[0].best_s()));
+      float s = 0.0f;
+      add(Interpolation::cardinal, opt_.tension, opt_.fit_tension ? &s : nullptr);
+      if (opt_.fit_tension) add(Interpolation::cardinal, s_to_tension(s));
       if (opt_.allow_linear) add(Interpolation::linear, opt_.tension);
     }
   } else {
-    for (CurveFit& c : candidates_) {
-      c.retarget(tol, step, changed);
-      c.refine();
-      c.prune();
+    for (Candidate& c : candidates_) {
+      CurveFit f(y, n, c.interp, tension_to_s(c.tension), opt_.rule, scratch);
+      f.resume(c.keys, tol, step, c.step, changed);
+      f.refine();
+      f.prune();
+      c.keys = f.keys();
+      c.step = step;
     }
   }
   size_t best = 0;
   for (size_t i = 1; i < candidates_.size(); ++i)
-    if (candidates_[i].key_count() < candidates_[best].key_count()) best = i;
-  return candidates_[best].result(tensions_[best]);
+    if (candidates_[i].keys.size() < candidates_[best].keys.size()) best = i;
+  const Candidate& b = candidates_[best];
+  return channel_at(y, b.interp, b.tension, b.step, b.keys);
 }
 
 }  // namespace keyanim::offline

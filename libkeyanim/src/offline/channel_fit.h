@@ -11,19 +11,75 @@
 
 namespace keyanim::offline {
 
+// A channel's tolerance at each frame: its base times a per-frame factor (1 where never
+// tightened), so that a tolerance costs 4 bytes per frame.
+struct Tolerance {
+  double base = 0.0;
+  const float* factor = nullptr;  // one per frame
+  double at(uint32_t f) const noexcept { return base * double(factor[f]); }
+};
+
+// The stored integer of a value: round half away from zero of y / step (std::llround).
+int64_t quantize(double y, double step) noexcept;
+
+// A key as the segment arithmetic sees it.
+struct Key {
+  uint32_t frame = 0;
+  float value = 0.0f;
+};
+
+// Operands of the segment from key a to key b, given the key before a and the key after b when
+// the channel has them (null at its ends): segment_operands on those (up to) four keys, which
+// duplicates end points exactly as it does over the whole list.
+inline SegmentOperands operands_between(const Key* before, Key a, Key b, const Key* after, Interpolation interp,
+                                        float s, TangentRule rule) noexcept {
+  uint32_t frames[4];
+  float values[4];
+  uint32_t n = 0, j = 0;
+  if (before) frames[n] = before->frame, values[n++] = before->value, j = 1;
+  frames[n] = a.frame, values[n++] = a.value;
+  frames[n] = b.frame, values[n++] = b.value;
+  if (after) frames[n] = after->frame, values[n++] = after->value;
+  return segment_operands(frames, values, n, j, interp, s, rule);
+}
+
+// The per-frame working arrays of a fit, reused from channel to channel (one per thread): what
+// a channel keeps between the encoder's rounds is then its keys, not arrays over its frames.
+// A CurveFit leaves the arrays clean when it is destroyed.
+struct FitScratch {
+  std::vector<uint32_t> prev, next;  // kNone at the ends, and for frames that are not keys
+  std::vector<uint8_t> is_key;
+  std::vector<int64_t> q;
+  std::vector<float> v;
+  std::vector<double> seg_ratio;  // per segment, indexed by its start frame
+  std::vector<uint32_t> seg_arg;
+  std::vector<double> y;          // the channel's signal, for the caller to fill
+  // Sizes every array for `frames` (keeping them clean).
+  void prepare(size_t frames);
+};
+
 // A channel's keys, kept within a per-frame tolerance by inserting keys at the worst frame
-// (a max-heap of segments) and pruning keys that are not needed. The state persists, so that
-// when the encoder tightens tolerances it refines from the keys it has instead of starting over.
+// (a max-heap of segments) and pruning keys that are not needed. Between the encoder's rounds
+// only the key frames are kept; resume() rebuilds from them exactly the state the fit had, so
+// that when tolerances tighten it refines from the keys it has instead of starting over.
 // The arithmetic is the decoder's own (cardinal.h): what is checked here is what plays back.
 class CurveFit {
  public:
-  CurveFit(const std::vector<double>& y, Interpolation interp, float s, TangentRule rule);
+  static constexpr uint32_t kNone = UINT32_MAX;
+
+  // y: `frames` values (kept by the caller for the fit's life).
+  CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule, FitScratch& scratch);
+  ~CurveFit();
+  CurveFit(const CurveFit&) = delete;
+  CurveFit& operator=(const CurveFit&) = delete;
 
   // Starts from `keys` (sorted; first and last frame included) with this tolerance and step.
-  void reset(const std::vector<uint32_t>& keys, const std::vector<double>& tol, double step);
-  // New tolerances (only ever smaller) and step: requantizes if the step changed, re-measures
-  // the segments holding `changed` frames (sorted; null: all of them).
-  void retarget(const std::vector<double>& tol, double step, const std::vector<uint32_t>* changed);
+  void reset(const std::vector<uint32_t>& keys, Tolerance tol, double step);
+  // Continues a fit that ended with `keys` at `previous_step`: the tolerance is tighter only at
+  // `changed` frames (sorted; null: anywhere). Re-measures the segments holding them, or every
+  // segment after requantizing when the step changed.
+  void resume(const std::vector<uint32_t>& keys, Tolerance tol, double step, double previous_step,
+              const std::vector<uint32_t>* changed);
   // Inserts keys at the worst frames until every frame is within tolerance.
   void refine();
   // Removes interior keys whose absence keeps every frame within tolerance: every key after
@@ -33,43 +89,37 @@ class CurveFit {
   float best_s() const;
 
   size_t key_count() const { return count_; }
-  EncodedChannel result(float tension) const;
+  std::vector<uint32_t> keys() const;
 
  private:
-  static constexpr uint32_t kNone = UINT32_MAX;
   struct Entry {
     double ratio;
     uint32_t start, end;
     bool operator<(const Entry& o) const { return ratio < o.ratio; }
   };
-  void quantize(uint32_t f);
+  void link_keys(const std::vector<uint32_t>& keys);
+  void quantize_at(uint32_t f);
   void link(uint32_t f, uint32_t a, uint32_t b);  // make f a key between keys a and b
   void unlink(uint32_t f);
   // Segment starting at key frame `start`: worst ratio |error| / tol over the frames inside
   // it; queued if over budget.
   void measure(uint32_t start, bool push = true);
   void measure_all();
+  bool try_remove(uint32_t f);
 
-  const std::vector<double>* y_;  // pointers, not references: fits are copied
-  const std::vector<double>* tol_ = nullptr;
+  const double* y_;
+  uint32_t frames_;
+  Tolerance tol_;
   double step_ = 1.0;
   Interpolation interp_;
   float s_;
   TangentRule rule_;
-  // Keys as a doubly linked list over frames, so inserting and removing are O(1).
+  FitScratch& w_;  // the per-frame arrays (a doubly linked list of keys over frames, O(1) edits)
   uint32_t first_ = kNone;
   size_t count_ = 0;
-  std::vector<uint32_t> prev_, next_;  // kNone at the ends, and for frames that are not keys
-  std::vector<uint8_t> is_key_;
-  std::vector<int64_t> q_;
-  std::vector<float> v_;
-  // Per segment, indexed by its start frame: worst ratio, worst frame.
-  std::vector<double> seg_ratio_;
-  std::vector<uint32_t> seg_arg_;
   std::priority_queue<Entry> heap_;  // lazily invalidated: checked against the list when popped
   std::vector<uint32_t> recent_;     // keys inserted since the last prune
   bool prune_all_ = true;
-  bool try_remove(uint32_t f);
 };
 
 struct ChannelFitOptions {
@@ -81,29 +131,36 @@ struct ChannelFitOptions {
 };
 
 // One key (or none for zero) if a single quantized value is within tolerance everywhere.
-std::optional<EncodedChannel> constant_channel(const std::vector<double>& y, const std::vector<double>& tol,
-                                               double step);
+// `lo` and `hi` are the smallest and largest of y.
+std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames, double lo, double hi,
+                                               Tolerance tol, double step);
 
 // Keys at the given frames (sorted, first and last included); values quantized with `step`.
 // Channels that are constant within `tol` still collapse to one key (or none if zero).
-EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys,
-                                   const std::vector<double>& tol, double step,
-                                   const ChannelFitOptions& options);
+EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys, Tolerance tol,
+                                   double step, const ChannelFitOptions& options, FitScratch& scratch);
 
 // The candidate fits of one channel in error mode (Cardinal with the given or fitted tension,
-// and linear), kept across the encoder's tightening rounds.
+// and linear), kept across the encoder's tightening rounds as their key frames.
 class ChannelFitter {
  public:
-  ChannelFitter(const std::vector<double>& y, const ChannelFitOptions& options);
-  // Fits (or refits, from the previous keys) to these tolerances, whose values changed only at
-  // `changed` frames since the last call (null: anywhere); returns the cheapest candidate.
-  EncodedChannel fit(const std::vector<double>& tol, double step, const std::vector<uint32_t>* changed = nullptr);
+  explicit ChannelFitter(const ChannelFitOptions& options) : opt_(options) {}
+  // Fits (or refits, from the previous keys) scratch.y (the channel's signal) to these
+  // tolerances, whose values changed only at `changed` frames since the last call (null:
+  // anywhere); returns the candidate with the fewest keys.
+  EncodedChannel fit(Tolerance tol, double step, const std::vector<uint32_t>* changed, FitScratch& scratch);
 
  private:
-  const std::vector<double>* y_;
+  struct Candidate {
+    Interpolation interp;
+    float tension;
+    double step = 0.0;            // of the last fit
+    std::vector<uint32_t> keys;   // key frames at the end of the last fit
+  };
   ChannelFitOptions opt_;
-  std::vector<CurveFit> candidates_;
-  std::vector<float> tensions_;
+  std::vector<Candidate> candidates_;
+  bool have_extent_ = false;
+  double lo_ = 0.0, hi_ = 0.0;  // extent of the signal (it does not change between rounds)
 };
 
 }  // namespace keyanim::offline

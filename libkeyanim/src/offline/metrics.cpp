@@ -1,6 +1,7 @@
 // Reconstruction error of a decoded motion against its original (see keyanim/offline/metrics.h).
 #include "keyanim/offline/metrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -10,6 +11,8 @@ namespace keyanim::offline {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kWindow = 256;            // frames per window, at least
+constexpr uint32_t kMaxWindows = 1024;       // beyond this, windows grow
 
 // A NaN difference means the decoded motion is broken: count it as infinitely wrong so that it
 // cannot hide behind comparisons that are false for NaN.
@@ -43,76 +46,99 @@ std::vector<bool> leaf_rotation_joints(const Skeleton& skeleton) {
 
 }  // namespace
 
+void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points) {
+  world_positions(skeleton, frame_row, points);
+}
+
+uint32_t measure_window(uint32_t frame_count) {
+  const uint32_t windows_of_min = (frame_count + kWindow - 1) / kWindow;
+  return kWindow * std::max<uint32_t>(1, (windows_of_min + kMaxWindows - 1) / kMaxWindows);
+}
+
+ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, const Skeleton* decoded)
+    : skeleton_(&skeleton),
+      decoded_skeleton_(decoded ? decoded : &skeleton),
+      joint_max_(skeleton.joints.size(), 0.0), channel_max_(skeleton.channel_count(), 0.0) {}
+
+void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const double* decoded) {
+  measured_points(*skeleton_, original, a_);
+  measured_points(*decoded_skeleton_, decoded, b_);
+  const size_t nodes = joint_max_.size();
+  for (size_t j = 0; j < nodes; ++j) {
+    double e = 0.0;
+    for (size_t p = j * kPointsPerNode; p < (j + 1) * kPointsPerNode; ++p) {
+      const double dx = a_[p][0] - b_[p][0];
+      const double dy = a_[p][1] - b_[p][1];
+      const double dz = a_[p][2] - b_[p][2];
+      e = std::max(e, sanitize(std::sqrt(dx * dx + dy * dy + dz * dz)));
+    }
+    sum_sq_ += e * e;
+    if (e > joint_max_[j]) joint_max_[j] = e;
+    if (!any_ || e > max_error_) {
+      max_error_ = e, worst_joint_ = static_cast<uint32_t>(j), worst_frame_ = frame;
+      any_ = true;
+    }
+  }
+  for (const Joint& joint : skeleton_->joints) {
+    for (size_t k = 0; k < joint.channels.size(); ++k) {
+      const size_t c = joint.first_channel + k;
+      channel_max_[c] = std::max(channel_max_[c], channel_difference(joint.channels[k], original[c], decoded[c]));
+    }
+  }
+}
+
+void ErrorAccumulator::merge(const ErrorAccumulator& later) {
+  sum_sq_ += later.sum_sq_;
+  if (later.any_ && (!any_ || later.max_error_ > max_error_))
+    max_error_ = later.max_error_, worst_joint_ = later.worst_joint_, worst_frame_ = later.worst_frame_, any_ = true;
+  for (size_t j = 0; j < joint_max_.size(); ++j) joint_max_[j] = std::max(joint_max_[j], later.joint_max_[j]);
+  for (size_t c = 0; c < channel_max_.size(); ++c) channel_max_[c] = std::max(channel_max_[c], later.channel_max_[c]);
+}
+
+ErrorReport ErrorAccumulator::report(uint32_t frames) const {
+  ErrorReport r;
+  r.max_error = max_error_;
+  r.worst_joint = worst_joint_;
+  r.worst_frame = worst_frame_;
+  r.joint_max = joint_max_;
+  r.channel_max = channel_max_;
+  const double samples = double(frames) * double(joint_max_.size());
+  r.rms_error = samples > 0 ? std::sqrt(sum_sq_ / samples) : 0.0;
+  const std::vector<bool> leaf = leaf_rotation_joints(*skeleton_);
+  for (size_t j = 0; j < leaf.size(); ++j) {
+    if (!leaf[j]) continue;
+    const Joint& joint = skeleton_->joints[j];
+    for (size_t k = 0; k < joint.channels.size(); ++k) {
+      const uint32_t c = joint.first_channel + static_cast<uint32_t>(k);
+      if (is_rotation(joint.channels[k]) && r.channel_max[c] > r.max_leaf_rotation)
+        r.max_leaf_rotation = r.channel_max[c];
+    }
+  }
+  return r;
+}
+
 ErrorReport measure_error(const Motion& original, const Motion& decoded) {
-  ErrorReport report;
   const size_t nodes = original.skeleton.joints.size();
   const uint32_t channels = original.channel_count();
   const uint32_t frames = original.frame_count;
-  report.joint_max.assign(nodes, 0.0);
-  report.channel_max.assign(channels, 0.0);
-
   if (decoded.channel_count() != channels || decoded.frame_count != frames ||
-      decoded.skeleton.joints.size() != nodes || !usable(original) ||
-      !usable(decoded)) {
+      decoded.skeleton.joints.size() != nodes || !usable(original) || !usable(decoded)) {
+    ErrorReport report;
     report.max_error = report.rms_error = report.max_leaf_rotation = kInf;
     report.joint_max.assign(nodes, kInf);
     report.channel_max.assign(channels, kInf);
     return report;
   }
-
-  std::vector<Vec3> a;
-  std::vector<Vec3> b;
-  double sum_sq = 0.0;
-  bool first = true;
-  for (uint32_t f = 0; f < frames; ++f) {
-    world_positions(original.skeleton, original.frame(f), a);
-    world_positions(decoded.skeleton, decoded.frame(f), b);
-    for (size_t j = 0; j < nodes; ++j) {
-      const double dx = a[j][0] - b[j][0];
-      const double dy = a[j][1] - b[j][1];
-      const double dz = a[j][2] - b[j][2];
-      const double e = sanitize(std::sqrt(dx * dx + dy * dy + dz * dz));
-      sum_sq += e * e;
-      if (e > report.joint_max[j]) report.joint_max[j] = e;
-      if (first || e > report.max_error) {
-        report.max_error = e;
-        report.worst_joint = static_cast<uint32_t>(j);
-        report.worst_frame = f;
-        first = false;
-      }
-    }
+  // Window by window, as a caller measuring in parallel does, so that both agree to the bit.
+  ErrorAccumulator total(original.skeleton, &decoded.skeleton);
+  const uint32_t window = measure_window(frames);
+  for (uint32_t first = 0; first < frames; first += window) {
+    ErrorAccumulator part(original.skeleton, &decoded.skeleton);
+    for (uint32_t f = first; f < std::min(frames, first + window); ++f)
+      part.add_frame(f, original.values.data() + size_t(f) * channels, decoded.values.data() + size_t(f) * channels);
+    total.merge(part);
   }
-  const double samples = double(frames) * double(nodes);
-  report.rms_error = samples > 0 ? std::sqrt(sum_sq / samples) : 0.0;
-
-  const size_t stride = channels;  // Motion::value would recount the channels at every call
-  for (uint32_t j = 0; j < nodes; ++j) {
-    const Joint& joint = original.skeleton.joints[j];
-    for (size_t k = 0; k < joint.channels.size(); ++k) {
-      const uint32_t c = joint.first_channel + static_cast<uint32_t>(k);
-      double m = 0.0;
-      for (uint32_t f = 0; f < frames; ++f) {
-        const double d = channel_difference(joint.channels[k], original.values[f * stride + c],
-                                            decoded.values[f * stride + c]);
-        if (d > m) m = d;
-      }
-      report.channel_max[c] = m;
-    }
-  }
-
-  const std::vector<bool> leaf = leaf_rotation_joints(original.skeleton);
-  for (size_t j = 0; j < nodes; ++j) {
-    if (!leaf[j]) continue;
-    const Joint& joint = original.skeleton.joints[j];
-    for (size_t k = 0; k < joint.channels.size(); ++k) {
-      const uint32_t c = joint.first_channel + static_cast<uint32_t>(k);
-      if (is_rotation(joint.channels[k]) &&
-          report.channel_max[c] > report.max_leaf_rotation) {
-        report.max_leaf_rotation = report.channel_max[c];
-      }
-    }
-  }
-  return report;
+  return total.report(frames);
 }
 
 }  // namespace keyanim::offline

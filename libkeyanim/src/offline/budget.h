@@ -1,0 +1,73 @@
+// The world-space tolerance turned into per-channel, per-frame budgets through the hierarchy,
+// and tightened where verification finds a node over. Internal to the encoder.
+//
+// A channel's error moves every node below it: a translation moves its own node and the
+// subtree, a rotation the strict descendants. The first budget of a rotation is the angle that
+// moves the farthest point below it by the whole tolerance; of a translation, the tolerance.
+// Where a node is over at a frame, every channel that moves it is tightened at that frame.
+// Everything here is linear in the number of nodes (a 32,000-joint chain costs 32,000 steps
+// per frame, not 32,000 squared).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "keyanim/offline/motion.h"
+#include "offline/channel_fit.h"
+
+namespace keyanim::offline {
+
+// For every node, the longest path (sum of local translation lengths, a position channel's
+// largest over the clip in place of its OFFSET component) down to any descendant.
+std::vector<double> reach_below(const Motion& motion);
+
+// Per channel, the first budget: `tol_units` for a translation; for a rotation, the angle in
+// degrees that moves a point at reach_below (at least `shell`) by `tol_units`.
+std::vector<double> base_tolerances(const Motion& motion, double tol_units, double shell);
+
+// A node over its budget at some frame, and the factor its movers' budgets are to be
+// multiplied by there (< 1).
+struct NodeRatio {
+  uint32_t node = 0;
+  double ratio = 1.0;
+};
+
+// Every channel's tolerance at every frame: its base times a per-frame factor. Factors are
+// stored as float, rounded down (a budget may come out a hair tighter than computed, never
+// looser): 4 bytes per value. Tracks which channels were tightened since they were last
+// taken for refitting, and at which frames.
+class Budgets {
+ public:
+  Budgets(const Skeleton& skeleton, std::vector<double> base, uint32_t frames);
+
+  uint32_t channel_count() const noexcept { return uint32_t(base_.size()); }
+  // The view a fit reads.
+  Tolerance tolerance(uint32_t c) const noexcept;
+  double min_tolerance(uint32_t c) const noexcept { return base_[c] * double(min_factor_[c]); }
+  // Quantization step: `fraction` of the base, halved until within `fraction` of the smallest
+  // tolerance. Halving rather than following the smallest tolerance: tightening a few frames
+  // then rarely requantizes the whole channel.
+  double step(uint32_t c, double fraction) const noexcept;
+
+  // Tightens, at `frame`, each channel that moves one of `over` by the smallest ratio among
+  // the nodes it moves. Frames must come in increasing order within a round.
+  void tighten(uint32_t frame, const std::vector<NodeRatio>& over);
+  // The channels tightened since the last call (all of them the first time), in order; their
+  // tightened frames stay readable through changed_frames until they are tightened again.
+  std::vector<uint32_t> take_dirty();
+  // Frames of channel c tightened in the round it was last tightened, increasing.
+  void changed_frames(uint32_t c, std::vector<uint32_t>& out) const;
+
+ private:
+  const Skeleton* skeleton_;
+  uint32_t frames_;
+  std::vector<double> base_;
+  std::vector<float> factor_;      // channel-major: factor_[c * frames_ + f]
+  std::vector<float> min_factor_;  // per channel
+  std::vector<uint8_t> dirty_;
+  size_t words_;                   // 64-bit words per channel in changed_
+  std::vector<uint64_t> changed_;  // per channel, a bit per frame
+  // Scratch of tighten(): per node, its own ratio and the smallest ratio strictly below it.
+  std::vector<double> own_, below_;
+};
+
+}  // namespace keyanim::offline

@@ -1,0 +1,78 @@
+#include "offline/signals.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "keyanim/offline/encode.h"
+#include "keyanim/offline/fk.h"
+#include "offline/parallel.h"
+
+namespace keyanim::offline {
+namespace {
+
+// Keys are binary32 at runtime: a value (or a position) beyond its range cannot play back.
+constexpr double kMaxMagnitude = 1e37;
+constexpr uint32_t kCheckWindow = 256;  // frames per FK job
+
+}  // namespace
+
+std::string check_motion(const Motion& m, unsigned threads) {
+  const uint32_t n_ch = m.channel_count();
+  if (m.values.size() != size_t(n_ch) * m.frame_count)
+    return "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels";
+  for (double v : m.values)
+    if (!(std::fabs(v) <= kMaxMagnitude)) return "a channel value is beyond what binary32 keys can hold (|v| > 1e37)";
+  const size_t windows = (size_t(m.frame_count) + kCheckWindow - 1) / kCheckWindow;
+  std::vector<uint8_t> overflow(windows, 0);
+  parallel_for(windows, threads, [&](size_t w, unsigned) {
+    std::vector<Vec3> pos;
+    const uint32_t end = uint32_t(std::min<size_t>(m.frame_count, (w + 1) * kCheckWindow));
+    for (uint32_t f = uint32_t(w * kCheckWindow); f < end && !overflow[w]; ++f) {
+      world_positions(m.skeleton, m.values.data() + size_t(f) * n_ch, pos);
+      for (const Vec3& p : pos)
+        if (!(std::fabs(p[0]) <= kMaxMagnitude && std::fabs(p[1]) <= kMaxMagnitude && std::fabs(p[2]) <= kMaxMagnitude))
+          overflow[w] = 1;
+    }
+  });
+  if (std::find(overflow.begin(), overflow.end(), 1) != overflow.end())
+    return "joint positions overflow (beyond 1e37 in file units)";
+  return {};
+}
+
+std::vector<uint8_t> rotation_channels(const Skeleton& s) {
+  std::vector<uint8_t> rot(s.channel_count(), 0);
+  for (const Joint& j : s.joints)
+    for (size_t k = 0; k < j.channels.size(); ++k) rot[j.first_channel + k] = is_rotation(j.channels[k]);
+  return rot;
+}
+
+void channel_signal(const Motion& m, uint32_t c, bool rotation, std::vector<double>& out) {
+  const size_t stride = m.channel_count();
+  out.resize(m.frame_count);
+  const double* v = m.values.data() + c;
+  for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = v[size_t(f) * stride];
+  if (rotation) unwrap_degrees(out);
+}
+
+void unwrap_degrees(std::vector<double>& y) {
+  for (size_t f = 1; f < y.size(); ++f) {
+    const double d = y[f] - y[f - 1];
+    // round(d / 360) is 0 exactly when |d| < 180: skip the libm call then (same result).
+    y[f] = std::fabs(d) < 180.0 ? y[f - 1] + d : y[f - 1] + d - 360.0 * std::round(d / 360.0);
+  }
+}
+
+double reference_size(const Motion& m) {
+  const double size = skeleton_size(m.skeleton);
+  if (size > 0.0) return size;
+  Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  std::vector<Vec3> pos;
+  for (uint32_t f = 0; f < m.frame_count; ++f) {
+    world_positions(m.skeleton, m.frame(f), pos);
+    for (const Vec3& p : pos)
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  }
+  return m.frame_count ? std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}) : 0.0;
+}
+
+}  // namespace keyanim::offline

@@ -1,0 +1,25 @@
+// The encoder's input: checks that a motion can be encoded, and each channel as the signal the
+// fitter works on (a column of the motion, unwrapped if it is an angle). Internal to the
+// encoder; unwrap_degrees and reference_size are public (encode.h).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "keyanim/offline/motion.h"
+
+namespace keyanim::offline {
+
+// Empty if `motion` can be encoded, else why: values and frames x channels disagree, a value
+// or a joint position is beyond what binary32 keys can hold. Positions are checked by FK,
+// frame windows on `threads` threads.
+std::string check_motion(const Motion& motion, unsigned threads);
+
+// Per channel: whether it is a rotation.
+std::vector<uint8_t> rotation_channels(const Skeleton& skeleton);
+
+// Channel c of `motion` over every frame into `out`, unwrapped (unwrap_degrees) if it is a
+// rotation. Reads a column of the frame-major values: the encoder keeps no copy of them.
+void channel_signal(const Motion& motion, uint32_t c, bool rotation, std::vector<double>& out);
+
+}  // namespace keyanim::offline

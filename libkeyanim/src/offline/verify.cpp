@@ -1,0 +1,157 @@
+#include "offline/verify.h"
+
+#include <algorithm>
+#include <cmath>
+#include <new>
+
+#include "keyanim/offline/container.h"
+#include "keyanim/offline/metrics.h"
+#include "offline/channel_fit.h"
+#include "offline/parallel.h"
+
+namespace keyanim::offline {
+namespace {
+
+Key key_at(const EncodedChannel& ch, size_t i) { return {ch.frames[i], dequantize(ch.q[i], ch.step)}; }
+
+// Frame of the key `back` keys before index i (0 past the start), and `ahead` keys after
+// index i (the last frame past the end).
+uint32_t frame_before(const EncodedChannel& ch, size_t i, size_t back) {
+  return i >= back ? ch.frames[i - back] : 0;
+}
+uint32_t frame_after(const EncodedChannel& ch, size_t i, size_t ahead, uint32_t last) {
+  return i + ahead < ch.frames.size() ? ch.frames[i + ahead] : last;
+}
+
+bool same_curve_kind(const EncodedChannel& a, const EncodedChannel& b) {
+  return a.interp == b.interp && (a.interp == Interpolation::linear || tension_to_s(a.tension) == tension_to_s(b.tension));
+}
+
+}  // namespace
+
+void decode_channel_at(const EncodedChannel& ch, TangentRule rule, const uint32_t* frames, size_t count, double* out,
+                       size_t stride) {
+  const size_t n = ch.frames.size();
+  if (n <= 1) {
+    const double v = n == 0 ? 0.0 : double(dequantize(ch.q[0], ch.step));
+    for (size_t i = 0; i < count; ++i) out[i * stride] = v;
+    return;
+  }
+  if (count == 0) return;
+  const uint32_t* k = ch.frames.data();
+  const float s = tension_to_s(ch.tension);
+  const double first = dequantize(ch.q[0], ch.step), last = dequantize(ch.q[n - 1], ch.step);
+  // j: the segment [k[j], k[j+1]) holding the frame (frames only increase).
+  size_t j = size_t(std::upper_bound(k, k + n, frames[0]) - k);
+  j = std::clamp<size_t>(j, 1, n - 1) - 1;
+  size_t prepared = n;  // segment whose operands are in ops
+  SegmentOperands ops;
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t f = frames[i];
+    double& v = out[i * stride];
+    if (f <= k[0]) { v = first; continue; }
+    if (f >= k[n - 1]) { v = last; continue; }
+    while (k[j + 1] <= f) ++j;
+    if (f == k[j]) { v = dequantize(ch.q[j], ch.step); continue; }
+    if (prepared != j) {
+      const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
+      ops = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1),
+                             j + 2 < n ? &after : nullptr, ch.interp, s, rule);
+      prepared = j;
+    }
+    v = eval_operands(ops, segment_u(k[j], k[j + 1], float(f)));
+  }
+}
+
+void changed_ranges(const EncodedChannel& a, const EncodedChannel& b, uint32_t frame_count,
+                    std::vector<std::pair<uint32_t, uint32_t>>& out) {
+  out.clear();
+  if (frame_count == 0) return;
+  const uint32_t last = frame_count - 1;
+  const size_t na = a.frames.size(), nb = b.frames.size();
+  if (!same_curve_kind(a, b) && (na > 1 || nb > 1)) return out.push_back({0, last});
+  uint32_t marked = 0;  // frames below this are already in `out`
+  auto mark = [&](uint32_t lo, uint32_t hi) {
+    lo = std::max(lo, marked);
+    if (lo > hi) return;
+    if (!out.empty() && lo <= out.back().second + 1) out.back().second = hi;
+    else out.push_back({lo, hi});
+    marked = hi + 1;
+  };
+  size_t i = 0, j = 0;  // merge both key lists by frame
+  while (i < na || j < nb) {
+    const uint32_t fa = i < na ? a.frames[i] : UINT32_MAX, fb = j < nb ? b.frames[j] : UINT32_MAX;
+    const uint32_t g = std::min(fa, fb);
+    const bool in_a = fa == g, in_b = fb == g;
+    const bool differs = !(in_a && in_b) || dequantize(a.q[i], a.step) != dequantize(b.q[j], b.step);
+    if (differs) {
+      // Keys strictly before g are a[0..i) and b[0..j); strictly after, from i (+1 if g is in a).
+      const uint32_t lo = std::min(frame_before(a, i, 2), frame_before(b, j, 2));
+      const uint32_t hi = std::max(frame_after(a, i + (in_a ? 1 : 0), 1, last), frame_after(b, j + (in_b ? 1 : 0), 1, last));
+      mark(lo, hi);  // 0 and the last frame when g is near an end: the clamped values
+    }
+    i += in_a, j += in_b;
+  }
+}
+
+void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
+                   uint32_t first, uint32_t count, uint8_t* check, std::vector<OverNode>& over, VerifyScratch& w) {
+  w.frames.clear();
+  for (uint32_t f = first; f < first + count; ++f)
+    if (check[f]) w.frames.push_back(f);
+  if (w.frames.empty()) return;
+  const size_t n_ch = channels.size(), nodes = m.skeleton.joints.size();
+  w.rows.resize(w.frames.size() * n_ch);
+  for (size_t c = 0; c < n_ch; ++c)
+    decode_channel_at(channels[c], rule, w.frames.data(), w.frames.size(), w.rows.data() + c, n_ch);
+  // The formula of measure_error, so that what passes here passes the final report; the square
+  // is compared first against a bound safely inside it (sqrt is correctly rounded).
+  const double surely_within = tol * tol * (1.0 - 1e-9);
+  for (size_t i = 0; i < w.frames.size(); ++i) {
+    const uint32_t f = w.frames[i];
+    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.original);
+    measured_points(m.skeleton, w.rows.data() + i * n_ch, w.decoded);
+    bool frame_over = false;
+    for (size_t d = 0; d < nodes; ++d) {
+      double e = 0.0;
+      for (size_t p = d * kPointsPerNode; p < (d + 1) * kPointsPerNode; ++p) {
+        const Vec3& a = w.original[p];
+        const Vec3& b = w.decoded[p];
+        const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+        const double sq = dx * dx + dy * dy + dz * dz;
+        if (sq <= surely_within) continue;
+        const double pe = std::sqrt(sq);
+        if (!(pe <= e)) e = pe;  // a NaN stays (and is over)
+      }
+      if (e <= tol) continue;
+      over.push_back({f, uint32_t(d), e});
+      frame_over = true;
+    }
+    check[f] = frame_over;
+  }
+}
+
+ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, unsigned threads) {
+  const Clip clip = to_clip(enc);
+  const uint32_t frames = m.frame_count, n_ch = m.channel_count();
+  const uint32_t window = measure_window(frames);
+  const size_t windows = (size_t(frames) + window - 1) / window;
+  std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton, &enc.skeleton));
+  parallel_for(windows, threads, [&](size_t w, unsigned) {
+    Cursor cursor;
+    if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
+    std::vector<float> row(n_ch);
+    std::vector<double> decoded(n_ch);
+    const uint32_t end = uint32_t(std::min<size_t>(frames, (w + 1) * window));
+    for (uint32_t f = uint32_t(w * window); f < end; ++f) {
+      clip.sample(double(f), row, &cursor);
+      std::copy(row.begin(), row.end(), decoded.begin());
+      parts[w].add_frame(f, m.values.data() + size_t(f) * n_ch, decoded.data());
+    }
+  });
+  ErrorAccumulator total(m.skeleton, &enc.skeleton);
+  for (const ErrorAccumulator& p : parts) total.merge(p);
+  return total.report(frames);
+}
+
+}  // namespace keyanim::offline
