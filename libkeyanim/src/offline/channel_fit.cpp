@@ -6,7 +6,15 @@
 
 namespace keyanim::offline {
 
-int64_t quantize(double y, double step) noexcept { return std::llround(y / step); }
+int64_t quantize(double y, double step) noexcept {
+  const double x = y / step;
+  // std::llround without the libm call where the integer conversion is exact: truncate, then
+  // round the (exactly computed) fraction half away from zero.
+  if (!(std::fabs(x) < 9.0e18)) return std::llround(x);
+  const int64_t t = static_cast<int64_t>(x);
+  const double frac = x - static_cast<double>(t);
+  return frac >= 0.5 ? t + 1 : frac <= -0.5 ? t - 1 : t;
+}
 
 void FitScratch::prepare(size_t frames) {
   if (prev.size() == frames) return;
@@ -89,13 +97,42 @@ void CurveFit::measure(uint32_t start, bool push) {
                                                {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
   double worst = 0.0;
   uint32_t arg = start + 1;
-  for (uint32_t f = start + 1; f < end; ++f) {
-    const float v = eval_operands(ops, segment_u(start, end, float(f)));
-    const double r = std::fabs(double(v) - y_[f]) / tol_.at(f);
-    if (r > worst) worst = r, arg = f;
+  if (end - start <= kShortSegment) {
+    for (uint32_t f = start + 1; f < end; ++f) {
+      const float v = eval_operands(ops, segment_u(start, end, float(f)));
+      const double r = std::fabs(double(v) - y_[f]) / tol_.at(f);
+      if (r > worst) worst = r, arg = f;
+    }
+  } else {
+    worst_in(ops, start, end, worst, arg);
   }
   w_.seg_ratio[start] = worst, w_.seg_arg[start] = arg;
   if (push && worst > 1.0) heap_.push({worst, start, end});
+}
+
+// The loop of measure() over a long segment, in chunks the compiler turns into vector
+// instructions: the same operations on every frame (segment_u with its constants hoisted), then
+// the first frame with the largest ratio. Frames are below 2^31, so converting them as signed
+// gives the same floats.
+void CurveFit::worst_in(const SegmentOperands& ops, uint32_t start, uint32_t end, double& worst,
+                        uint32_t& arg) const {
+  constexpr uint32_t kChunk = 64;
+  double r[kChunk];
+  const float a = static_cast<float>(start);
+  const float len = static_cast<float>(end) - a;
+  const double base = tol_.base;
+  for (uint32_t c0 = start + 1; c0 < end; c0 += kChunk) {
+    const uint32_t m = std::min(kChunk, end - c0);
+    const double* y = y_ + c0;
+    const float* factor = tol_.factor + c0;
+    const int32_t first = static_cast<int32_t>(c0);
+    for (uint32_t i = 0; i < m; ++i) {
+      const float v = eval_operands(ops, (static_cast<float>(first + static_cast<int32_t>(i)) - a) / len);
+      r[i] = std::fabs(double(v) - y[i]) / (base * double(factor[i]));
+    }
+    for (uint32_t i = 0; i < m; ++i)
+      if (r[i] > worst) worst = r[i], arg = c0 + i;
+  }
 }
 
 void CurveFit::link(uint32_t f, uint32_t a, uint32_t b) {
@@ -196,10 +233,16 @@ float CurveFit::best_s() const {
   return float(std::clamp(num / den, 0.0, 1.0));
 }
 
-std::vector<uint32_t> CurveFit::keys() const {
-  std::vector<uint32_t> out;
-  out.reserve(count_);
-  for (uint32_t f = first_; f != kNone; f = w_.next[f]) out.push_back(f);
+std::vector<uint32_t> CurveFit::take_keys() {
+  std::vector<uint32_t> out(count_);
+  size_t i = 0;
+  for (uint32_t f = first_; f != kNone; ++i) {
+    const uint32_t next = w_.next[f];
+    out[i] = f;
+    w_.prev[f] = w_.next[f] = kNone, w_.is_key[f] = 0;
+    f = next;
+  }
+  first_ = kNone, count_ = 0;
   return out;
 }
 
@@ -272,7 +315,7 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
       c.refine();
       c.prune();
       if (best_s) *best_s = c.best_s();
-      candidates_.push_back({interp, tension, step, c.keys()});
+      candidates_.push_back({interp, tension, step, c.take_keys()});
     };
     if (opt_.force_linear) {
       add(Interpolation::linear, opt_.tension);
@@ -289,7 +332,7 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
       f.resume(c.keys, tol, step, c.step, changed);
       f.refine();
       f.prune();
-      c.keys = f.keys();
+      c.keys = f.take_keys();
       c.step = step;
     }
   }

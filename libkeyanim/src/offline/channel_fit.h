@@ -89,7 +89,8 @@ class CurveFit {
   float best_s() const;
 
   size_t key_count() const { return count_; }
-  std::vector<uint32_t> keys() const;
+  // The key frames; leaves the fit empty and its scratch clean (cheaper than the destructor).
+  std::vector<uint32_t> take_keys();
 
  private:
   struct Entry {
@@ -104,6 +105,8 @@ class CurveFit {
   // Segment starting at key frame `start`: worst ratio |error| / tol over the frames inside
   // it; queued if over budget.
   void measure(uint32_t start, bool push = true);
+  static constexpr uint32_t kShortSegment = 8;  // shorter segments skip the vectorized loop
+  void worst_in(const SegmentOperands& ops, uint32_t start, uint32_t end, double& worst, uint32_t& arg) const;
   void measure_all();
   bool try_remove(uint32_t f);
 

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/curvature.h"
@@ -66,16 +65,16 @@ struct Job {
   double tol_units;
   unsigned threads;
   std::vector<uint32_t> fixed_keys;  // uniform and manual modes
+  ChannelLayout layout;
   EncodedClip& enc;
 };
 
-// Fits the channels whose budgets changed (all of them in round 0) and marks in `check` the
-// frames whose decoded values may have changed.
+// Fits the channels whose budgets changed (all of them in round 0) and marks the frames whose
+// decoded values may have changed.
 void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<ChannelFitter>& fitters,
-                  std::vector<uint8_t>& check) {
+                  FrameMarks& marks) {
   const Motion& m = job.m;
   const std::vector<uint32_t> refit = budgets.take_dirty();
-  const std::vector<uint8_t> rotation = rotation_channels(m.skeleton);
   const ChannelFitOptions options = fit_options(job.settings);
   struct Worker {
     FitScratch fit;
@@ -87,7 +86,7 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
   parallel_for(refit.size(), job.threads, [&](size_t i, unsigned w) {
     const uint32_t c = refit[i];
     Worker& s = workers[w];
-    channel_signal(m, c, rotation[c], s.fit.y);
+    channel_signal(m, c, job.layout.rotation[c], s.fit.y);
     const Tolerance tol = budgets.tolerance(c);
     const double step = budgets.step(c, kStepFraction);
     EncodedChannel fitted;
@@ -104,12 +103,12 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
     if (round > 0) changed_ranges(job.enc.channels[c], fitted, m.frame_count, ranges[i]);
     job.enc.channels[c] = std::move(fitted);
   });
-  for (const auto& list : ranges)
-    for (const auto& [a, b] : list) std::memset(check.data() + a, 1, size_t(b - a) + 1);
+  for (size_t i = 0; i < refit.size(); ++i)
+    for (const auto& [a, b] : ranges[i]) marks.mark(job.layout.node[refit[i]], a, b);
 }
 
 // Verifies the marked frames; tightens budgets where a node is over. False if none is.
-bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, std::vector<uint8_t>& check) {
+bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameMarks& marks) {
   const uint32_t frames = job.m.frame_count;
   const size_t windows = (size_t(frames) + kVerifyWindow - 1) / kVerifyWindow;
   std::vector<std::vector<OverNode>> over(windows);
@@ -117,8 +116,9 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, std::v
   parallel_for(windows, job.threads, [&](size_t w, unsigned t) {
     const uint32_t first = uint32_t(w * kVerifyWindow);
     verify_window(job.m, job.enc.channels, job.enc.tangent_rule, job.tol_units, first,
-                  std::min(kVerifyWindow, frames - first), check.data(), over[w], scratch[t]);
+                  std::min(kVerifyWindow, frames - first), marks, over[w], scratch[t]);
   });
+  marks.clear_moved();
   // Each channel that moves an over-budget node is tightened at that frame by the largest
   // ratio any of its nodes needs, frame after frame.
   bool any = false;
@@ -142,11 +142,12 @@ uint32_t fit_within_tolerance(const Job& job, double size, std::string& error) {
   const Motion& m = job.m;
   Budgets budgets(m.skeleton, base_tolerances(m, job.tol_units, kShellFraction * size), m.frame_count);
   std::vector<ChannelFitter> fitters(m.channel_count(), ChannelFitter(fit_options(job.settings)));
-  std::vector<uint8_t> check(m.frame_count, 1);  // frames to verify: values changed, or over last round
+  FrameMarks marks(m.frame_count, m.skeleton.joints.size());
+  marks.mark_all();
   for (uint32_t round = 0;; ++round) {
-    fit_channels(job, round, budgets, fitters, check);
+    fit_channels(job, round, budgets, fitters, marks);
     if (job.settings.key_mode != KeyMode::error || m.frame_count == 0) return round + 1;
-    if (!verify_and_tighten(job, round, budgets, check)) return round + 1;
+    if (!verify_and_tighten(job, round, budgets, marks)) return round + 1;
     if (round + 1 >= kMaxRounds) {
       error = "could not reach the tolerance of " + std::to_string(job.tol_units) + " units after " +
               std::to_string(kMaxRounds) + " rounds (below float32 precision?)";
@@ -187,7 +188,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   enc.frame_time = m.frame_time;
   enc.tangent_rule = settings.tangent_rule;
   enc.channels.resize(m.channel_count());
-  Job job{m, settings, tol_units, threads, {}, enc};
+  Job job{m, settings, tol_units, threads, {}, channel_layout(m.skeleton), enc};
   if (settings.key_mode == KeyMode::uniform) job.fixed_keys = uniform_keys(m.frame_count, settings.uniform_interval);
   if (settings.key_mode == KeyMode::manual && !manual_keys(settings.manual_frames, m.frame_count, job.fixed_keys, error))
     return false;

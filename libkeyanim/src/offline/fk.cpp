@@ -70,14 +70,23 @@ namespace {
 
 // m = m * R_axis(angle). Only the two columns other than `axis` change:
 // col_a' = c*col_a + s*col_b, col_b' = c*col_b - s*col_a with (a, b) = (axis+1, axis+2) mod 3.
-inline void post_rotate(Mat3& m, int axis, double s, double c) noexcept {
-  const int a = (axis + 1) % 3;
-  const int b = (axis + 2) % 3;
+// One instance per axis, so that the indices are constants (FK is most of the encoder's time).
+template <int Axis>
+inline void post_rotate_axis(Mat3& m, double s, double c) noexcept {
+  constexpr int a = (Axis + 1) % 3;
+  constexpr int b = (Axis + 2) % 3;
   for (int r = 0; r < 3; ++r) {
     const double ma = m[r * 3 + a];
     const double mb = m[r * 3 + b];
     m[r * 3 + a] = c * ma + s * mb;
     m[r * 3 + b] = c * mb - s * ma;
+  }
+}
+inline void post_rotate(Mat3& m, int axis, double s, double c) noexcept {
+  switch (axis) {
+    case 0: return post_rotate_axis<0>(m, s, c);
+    case 1: return post_rotate_axis<1>(m, s, c);
+    default: return post_rotate_axis<2>(m, s, c);
   }
 }
 
@@ -96,11 +105,14 @@ struct GivenSinCos {
   }
 };
 
-// The one FK loop everything else uses. pos and rot have room for every node.
+// The one FK loop everything else uses. pos and rot have room for every node. With `nodes`,
+// only the nodes it marks (a set holding every ancestor of its members) are computed.
 template <typename SinCos>
-void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* rot, SinCos sin_cos) noexcept {
+void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* rot, SinCos sin_cos,
+                const uint8_t* nodes = nullptr) noexcept {
   const size_t n = skeleton.joints.size();
   for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
     const Joint& joint = skeleton.joints[j];
     const bool root = is_root(joint, j);
     const Mat3& parent_rot = root ? kIdentity : rot[joint.parent];
@@ -151,18 +163,22 @@ namespace {
 // per-frame calls allocate nothing after the first.
 template <typename SinCos>
 void positions_with_scratch(const Skeleton& skeleton, const double* frame_row, SinCos sin_cos,
-                            std::vector<Vec3>& out) {
+                            std::vector<Vec3>& out, const uint8_t* nodes = nullptr) {
   thread_local std::vector<Mat3> rotations;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n);
   out.resize(n);
-  pose_frame(skeleton, frame_row, out.data(), rotations.data(), sin_cos);
+  pose_frame(skeleton, frame_row, out.data(), rotations.data(), sin_cos, nodes);
 }
 
 }  // namespace
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out) {
   positions_with_scratch(skeleton, frame_row, ComputeSinCos{}, out);
+}
+
+void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out) {
+  positions_with_scratch(skeleton, frame_row, ComputeSinCos{}, out, nodes);
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,

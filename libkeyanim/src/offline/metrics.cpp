@@ -46,8 +46,10 @@ std::vector<bool> leaf_rotation_joints(const Skeleton& skeleton) {
 
 }  // namespace
 
-void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points) {
-  world_positions(skeleton, frame_row, points);
+void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points,
+                     const uint8_t* nodes) {
+  if (nodes) world_positions(skeleton, frame_row, nodes, points);
+  else world_positions(skeleton, frame_row, points);
 }
 
 uint32_t measure_window(uint32_t frame_count) {

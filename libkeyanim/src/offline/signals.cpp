@@ -39,11 +39,18 @@ std::string check_motion(const Motion& m, unsigned threads) {
   return {};
 }
 
-std::vector<uint8_t> rotation_channels(const Skeleton& s) {
-  std::vector<uint8_t> rot(s.channel_count(), 0);
-  for (const Joint& j : s.joints)
-    for (size_t k = 0; k < j.channels.size(); ++k) rot[j.first_channel + k] = is_rotation(j.channels[k]);
-  return rot;
+ChannelLayout channel_layout(const Skeleton& s) {
+  ChannelLayout out;
+  out.node.resize(s.channel_count());
+  out.rotation.resize(out.node.size());
+  for (size_t j = 0; j < s.joints.size(); ++j) {
+    const Joint& joint = s.joints[j];
+    for (size_t k = 0; k < joint.channels.size(); ++k) {
+      out.node[joint.first_channel + k] = uint32_t(j);
+      out.rotation[joint.first_channel + k] = is_rotation(joint.channels[k]);
+    }
+  }
+  return out;
 }
 
 void channel_signal(const Motion& m, uint32_t c, bool rotation, std::vector<double>& out) {

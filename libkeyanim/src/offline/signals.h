@@ -15,8 +15,12 @@ namespace keyanim::offline {
 // frame windows on `threads` threads.
 std::string check_motion(const Motion& motion, unsigned threads);
 
-// Per channel: whether it is a rotation.
-std::vector<uint8_t> rotation_channels(const Skeleton& skeleton);
+// Per channel: the node it belongs to, and whether it is a rotation.
+struct ChannelLayout {
+  std::vector<uint32_t> node;
+  std::vector<uint8_t> rotation;
+};
+ChannelLayout channel_layout(const Skeleton& skeleton);
 
 // Channel c of `motion` over every frame into `out`, unwrapped (unwrap_degrees) if it is a
 // rotation. Reads a column of the frame-major values: the encoder keeps no copy of them.

@@ -29,38 +29,30 @@ bool same_curve_kind(const EncodedChannel& a, const EncodedChannel& b) {
 
 }  // namespace
 
+double ChannelCursor::at(uint32_t f) {
+  const EncodedChannel& ch = *ch_;
+  const size_t n = ch.frames.size();
+  if (n == 0) return 0.0;
+  const uint32_t* k = ch.frames.data();
+  if (n == 1 || f <= k[0]) return dequantize(ch.q[0], ch.step);
+  if (f >= k[n - 1]) return dequantize(ch.q[n - 1], ch.step);
+  if (j_ == SIZE_MAX) j_ = size_t(std::upper_bound(k, k + n, f) - k) - 1;  // k[0] < f < k[n-1]
+  while (k[j_ + 1] <= f) ++j_;
+  if (f == k[j_]) return dequantize(ch.q[j_], ch.step);
+  if (prepared_ != j_) {
+    const size_t j = j_;
+    const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
+    ops_ = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
+                            ch.interp, tension_to_s(ch.tension), rule_);
+    prepared_ = j;
+  }
+  return eval_operands(ops_, segment_u(k[j_], k[j_ + 1], float(f)));
+}
+
 void decode_channel_at(const EncodedChannel& ch, TangentRule rule, const uint32_t* frames, size_t count, double* out,
                        size_t stride) {
-  const size_t n = ch.frames.size();
-  if (n <= 1) {
-    const double v = n == 0 ? 0.0 : double(dequantize(ch.q[0], ch.step));
-    for (size_t i = 0; i < count; ++i) out[i * stride] = v;
-    return;
-  }
-  if (count == 0) return;
-  const uint32_t* k = ch.frames.data();
-  const float s = tension_to_s(ch.tension);
-  const double first = dequantize(ch.q[0], ch.step), last = dequantize(ch.q[n - 1], ch.step);
-  // j: the segment [k[j], k[j+1]) holding the frame (frames only increase).
-  size_t j = size_t(std::upper_bound(k, k + n, frames[0]) - k);
-  j = std::clamp<size_t>(j, 1, n - 1) - 1;
-  size_t prepared = n;  // segment whose operands are in ops
-  SegmentOperands ops;
-  for (size_t i = 0; i < count; ++i) {
-    const uint32_t f = frames[i];
-    double& v = out[i * stride];
-    if (f <= k[0]) { v = first; continue; }
-    if (f >= k[n - 1]) { v = last; continue; }
-    while (k[j + 1] <= f) ++j;
-    if (f == k[j]) { v = dequantize(ch.q[j], ch.step); continue; }
-    if (prepared != j) {
-      const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
-      ops = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1),
-                             j + 2 < n ? &after : nullptr, ch.interp, s, rule);
-      prepared = j;
-    }
-    v = eval_operands(ops, segment_u(k[j], k[j + 1], float(f)));
-  }
+  ChannelCursor cursor(ch, rule);
+  for (size_t i = 0; i < count; ++i) out[i * stride] = cursor.at(frames[i]);
 }
 
 void changed_ranges(const EncodedChannel& a, const EncodedChannel& b, uint32_t frame_count,
@@ -94,25 +86,64 @@ void changed_ranges(const EncodedChannel& a, const EncodedChannel& b, uint32_t f
   }
 }
 
+FrameMarks::FrameMarks(uint32_t frames, size_t nodes)
+    : words_((size_t(frames) + 63) / 64), check_(frames, 0), moved_(nodes * words_, 0) {}
+
+void FrameMarks::mark(uint32_t node, uint32_t first, uint32_t last) {
+  for (uint32_t f = first; f <= last; ++f) check_[f] |= kChanged;
+  uint64_t* bits = moved_.data() + node * words_;
+  for (uint32_t f = first; f <= last;) {
+    if (f % 64 == 0 && last - f >= 63) {
+      bits[f / 64] = ~uint64_t(0);
+      f += 64;
+    } else {
+      bits[f / 64] |= uint64_t(1) << (f % 64);
+      ++f;
+    }
+  }
+}
+
+void FrameMarks::clear_moved() { std::fill(moved_.begin(), moved_.end(), 0); }
+
 void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
-                   uint32_t first, uint32_t count, uint8_t* check, std::vector<OverNode>& over, VerifyScratch& w) {
-  w.frames.clear();
-  for (uint32_t f = first; f < first + count; ++f)
-    if (check[f]) w.frames.push_back(f);
-  if (w.frames.empty()) return;
-  const size_t n_ch = channels.size(), nodes = m.skeleton.joints.size();
-  w.rows.resize(w.frames.size() * n_ch);
-  for (size_t c = 0; c < n_ch; ++c)
-    decode_channel_at(channels[c], rule, w.frames.data(), w.frames.size(), w.rows.data() + c, n_ch);
+                   uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over, VerifyScratch& w) {
+  uint8_t* check = marks.check();
+  const auto& joints = m.skeleton.joints;
+  const size_t n_ch = channels.size(), nodes = joints.size();
+  w.cursors.resize(n_ch);
+  for (size_t c = 0; c < n_ch; ++c) w.cursors[c] = ChannelCursor(channels[c], rule);
+  w.row.resize(n_ch);
+  w.measure.resize(nodes);
+  w.pose.resize(nodes);
   // The formula of measure_error, so that what passes here passes the final report; the square
   // is compared first against a bound safely inside it (sqrt is correctly rounded).
   const double surely_within = tol * tol * (1.0 - 1e-9);
-  for (size_t i = 0; i < w.frames.size(); ++i) {
-    const uint32_t f = w.frames[i];
-    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.original);
-    measured_points(m.skeleton, w.rows.data() + i * n_ch, w.decoded);
+  for (uint32_t f = first; f < first + count; ++f) {
+    if (!check[f]) continue;
+    // Nodes to measure: all, or the subtrees of the nodes that moved; to pose: those and
+    // their ancestors.
+    const bool all = check[f] & FrameMarks::kOver;
+    for (size_t j = 0; j < nodes; ++j) {
+      const int32_t p = joints[j].parent;
+      w.measure[j] = all || marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && w.measure[size_t(p)]);
+      w.pose[j] = w.measure[j];
+    }
+    for (size_t j = nodes; j-- > 0;) {
+      const int32_t p = joints[j].parent;
+      if (w.pose[j] && p >= 0 && size_t(p) < j) w.pose[size_t(p)] = 1;
+    }
+    for (size_t j = 0; j < nodes; ++j) {
+      if (!w.pose[j]) continue;
+      for (size_t k = 0; k < joints[j].channels.size(); ++k) {
+        const size_t c = joints[j].first_channel + k;
+        w.row[c] = w.cursors[c].at(f);
+      }
+    }
+    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.original, w.pose.data());
+    measured_points(m.skeleton, w.row.data(), w.decoded, w.pose.data());
     bool frame_over = false;
     for (size_t d = 0; d < nodes; ++d) {
+      if (!w.measure[d]) continue;
       double e = 0.0;
       for (size_t p = d * kPointsPerNode; p < (d + 1) * kPointsPerNode; ++p) {
         const Vec3& a = w.original[p];
@@ -127,7 +158,7 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
       over.push_back({f, uint32_t(d), e});
       frame_over = true;
     }
-    check[f] = frame_over;
+    check[f] = frame_over ? FrameMarks::kOver : 0;
   }
 }
 

@@ -3,6 +3,7 @@
 // the measured points (metrics.h), window of frames by window, so that memory does not grow
 // with the clip. Internal to the encoder.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -12,9 +13,25 @@
 
 namespace keyanim::offline {
 
-// The values a decoder computes for channel `ch` at the sorted frames `frames[0..count)`, into
-// out[i * stride]: the stored keys dequantized, segment_operands, segment_u, eval_operands, with
-// the curve clamped outside its keys and exactly a key's value at a key.
+// Decodes one channel at increasing frames, as a decoder computes it: the stored keys
+// dequantized, segment_operands, segment_u, eval_operands, with the curve clamped outside its
+// keys and exactly a key's value at a key. Keeps its segment between calls.
+class ChannelCursor {
+ public:
+  ChannelCursor() = default;
+  ChannelCursor(const EncodedChannel& ch, TangentRule rule) : ch_(&ch), rule_(rule) {}
+  // The value at frame f; f must not decrease from call to call.
+  double at(uint32_t f);
+
+ private:
+  const EncodedChannel* ch_ = nullptr;
+  TangentRule rule_ = TangentRule::step_adjusted;
+  size_t j_ = SIZE_MAX;         // segment [k[j], k[j+1]) of the last frame; SIZE_MAX: none yet
+  size_t prepared_ = SIZE_MAX;  // segment whose operands are in ops_
+  SegmentOperands ops_;
+};
+
+// The values of channel `ch` at the sorted frames `frames[0..count)`, into out[i * stride].
 void decode_channel_at(const EncodedChannel& ch, TangentRule rule, const uint32_t* frames, size_t count, double* out,
                        size_t stride);
 
@@ -32,19 +49,44 @@ struct OverNode {
   double error = 0.0;  // file length units: the largest distance among the node's measured points
 };
 
+// What to verify, frame by frame, and which nodes may have moved there.
+class FrameMarks {
+ public:
+  static constexpr uint8_t kChanged = 1;  // some decoded value may have changed
+  static constexpr uint8_t kOver = 2;     // over the tolerance when last verified: verify every node
+
+  FrameMarks(uint32_t frames, size_t nodes);
+  // Frame f is to be verified in full (every frame, in the first round).
+  void mark_all() { std::fill(check_.begin(), check_.end(), kOver); }
+  // Channels of `node` may decode differently at frames [first, last].
+  void mark(uint32_t node, uint32_t first, uint32_t last);
+  // Forgets which nodes moved (after a round's verification).
+  void clear_moved();
+  uint8_t* check() { return check_.data(); }
+  bool moved(uint32_t node, uint32_t f) const { return moved_[node * words_ + f / 64] >> (f % 64) & 1; }
+
+ private:
+  size_t words_;
+  std::vector<uint8_t> check_;   // per frame
+  std::vector<uint64_t> moved_;  // per node, a bit per frame
+};
+
 // Working memory of verify_window, one per thread.
 struct VerifyScratch {
-  std::vector<uint32_t> frames;
-  std::vector<double> rows;
+  std::vector<ChannelCursor> cursors;
+  std::vector<double> row;
+  std::vector<uint8_t> measure, pose;  // per node: its error is measured; it is posed
   std::vector<Vec3> original, decoded;
 };
 
-// Verifies the frames f of [first, first + count) whose check[f] is set: decodes every channel
-// there, poses original and decoded, and appends to `over` each node whose error exceeds
-// `tolerance` (frame order, then node order) with its error, computed as measure_error does.
-// check[f] stays set for frames with a node over and is cleared for the others.
+// Verifies the frames f of [first, first + count) marked in `marks`: decodes the channels of
+// the nodes that moved there (and their ancestors), poses original and decoded, and appends to
+// `over` each node whose error exceeds `tolerance` (frame order, then node order) with its
+// error, computed as measure_error does. A frame marked only kChanged measures only the
+// subtrees of the nodes that moved: the others have not moved since they were last found
+// within the tolerance. Frames with a node over stay marked kOver; the others are unmarked.
 void verify_window(const Motion& original, const std::vector<EncodedChannel>& channels, TangentRule rule,
-                   double tolerance, uint32_t first, uint32_t count, uint8_t* check, std::vector<OverNode>& over,
+                   double tolerance, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
                    VerifyScratch& scratch);
 
 // The error report of `clip` (valid: validate_encoded_clip) against `original`, on the clip a

@@ -37,6 +37,11 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row);
 // scratch buffer have reached the skeleton's size.
 void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out);
 
+// The same for the nodes j with nodes[j] != 0 only, a set that must hold every ancestor of
+// its members (positions of the other nodes are left as they were): for callers that know
+// which nodes moved.
+void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out);
+
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values
 // change. Bit-identical to the plain call.

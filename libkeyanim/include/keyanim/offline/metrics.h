@@ -27,8 +27,11 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded);
 // world position (FK of `frame_row`). Every error keyanim reports or verifies goes through
 // this one function, so that adding points (virtual points around each joint, say) changes
 // the report, the encoder's verification and its guarantee together.
+// With `nodes`, only the points of the nodes it marks (a set holding every ancestor of its
+// members) are computed; the others are left as they were.
 constexpr uint32_t kPointsPerNode = 1;
-void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points);
+void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points,
+                     const uint8_t* nodes = nullptr);
 
 // measure_error in pieces, for callers that produce the decoded frames themselves (window by
 // window, on several threads): add frames to one accumulator per window, merge the windows in
