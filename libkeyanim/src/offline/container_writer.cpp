@@ -18,6 +18,7 @@
 #include "keyanim/version.h"
 #include "runtime/clip_access.h"
 #include "internal/clip_source.h"
+#include "offline/parallel.h"
 
 namespace keyanim::offline {
 namespace {
@@ -255,32 +256,41 @@ std::string validate_encoded_clip(const EncodedClip& clip) {
   return {};
 }
 
-std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level) {
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level, unsigned threads) {
   if (!validate_encoded_clip(clip).empty()) return {};
   uint64_t keys = 0;
   for (const auto& c : clip.channels) keys += c.frames.size();
 
   const int level = std::min(zstd_level, ZSTD_maxCLevel());
-  // Null (level <= 0, or out of memory): every section is stored raw, still a valid file.
-  ZSTD_CCtx* cctx = level > 0 ? ZSTD_createCCtx() : nullptr;
-  std::vector<Section> sections;
-  sections.push_back(make_section(internal::kTagClip, 0, clip_section(clip, keys), nullptr, level));
-  sections.push_back(make_section(internal::kTagSkel, 0, skel_section(clip.skeleton), cctx, level));
-  const ValuePlan plan = plan_values(clip.channels);
-  sections.push_back(make_section(internal::kTagChan, 0, chan_section(clip.channels, plan), cctx, level));
-  sections.push_back(make_section(internal::kTagKtim, 0, ktim_section(clip.channels), cctx, level));
-  {
-    // A block per plane: each gets its own entropy tables. (Also compressing without the
-    // breaks and keeping the smaller won 0.005% on the CMU clips for a fifth of the encode.)
+  struct Raw {
+    uint32_t tag, flags;
+    std::vector<uint8_t> bytes;
+    bool compress;
     std::vector<size_t> breaks;
-    std::vector<uint8_t> kval = kval_section(clip.channels, plan, breaks);
-    sections.push_back(make_section(internal::kTagKval, 0, std::move(kval), cctx, level, breaks));
-  }
-  if (!clip.notes.empty()) {
-    std::vector<uint8_t> text(clip.notes.begin(), clip.notes.end());
-    sections.push_back(make_section(internal::kTagNote, internal::kSectionAncillary, std::move(text), cctx, level));
-  }
-  ZSTD_freeCCtx(cctx);
+  };
+  std::vector<Raw> raw;
+  auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes, bool compress = true) {
+    raw.push_back({tag, flags, std::move(bytes), compress, {}});
+  };
+  add(internal::kTagClip, 0, clip_section(clip, keys), false);
+  add(internal::kTagSkel, 0, skel_section(clip.skeleton));
+  const ValuePlan plan = plan_values(clip.channels);
+  add(internal::kTagChan, 0, chan_section(clip.channels, plan));
+  add(internal::kTagKtim, 0, ktim_section(clip.channels));
+  // A block per plane: each gets its own entropy tables. (Also compressing without the
+  // breaks and keeping the smaller won 0.005% on the CMU clips for a fifth of the encode.)
+  std::vector<size_t> breaks;
+  add(internal::kTagKval, 0, kval_section(clip.channels, plan, breaks));
+  raw.back().breaks = std::move(breaks);
+  if (!clip.notes.empty()) add(internal::kTagNote, internal::kSectionAncillary, {clip.notes.begin(), clip.notes.end()});
+  // Sections are independent zstd frames: compressed on several threads, the bytes are the same.
+  std::vector<Section> sections(raw.size());
+  parallel_for(raw.size(), threads, [&](size_t i, unsigned) {
+    // Null (level <= 0, or out of memory): the section is stored raw, still a valid file.
+    ZSTD_CCtx* cctx = level > 0 && raw[i].compress ? ZSTD_createCCtx() : nullptr;
+    sections[i] = make_section(raw[i].tag, raw[i].flags, std::move(raw[i].bytes), cctx, level, raw[i].breaks);
+    ZSTD_freeCCtx(cctx);
+  });
 
   std::vector<uint8_t> out;
   size_t total = internal::kHeaderEnd + internal::kTableEntrySize * sections.size() + internal::kChecksumSize;

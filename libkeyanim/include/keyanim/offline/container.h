@@ -16,9 +16,10 @@ std::string validate_encoded_clip(const EncodedClip& clip);
 
 // The complete file: signature, header, section table, sections, CRC-32. Each section is a
 // zstd frame at `zstd_level` (clamped to at most zstd's maximum) when that is smaller, else
-// stored raw; zstd_level <= 0 stores every section raw. Returns an empty vector if
-// validate_encoded_clip(clip) is not empty.
-std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level = 19);
+// stored raw; zstd_level <= 0 stores every section raw. Sections are compressed on up to
+// `threads` threads (0: one per core); the bytes do not depend on it. Returns an empty vector
+// if validate_encoded_clip(clip) is not empty.
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level = 19, unsigned threads = 1);
 
 // The clip a decoder builds from write_kanim(clip), without the bytes: the encoder verifies
 // its error on this. Its arrays are identical to those Clip::load builds from the file.
