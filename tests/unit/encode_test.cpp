@@ -4,6 +4,10 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
+
+#include "corpus_files.h"
+#include "keyanim/offline/bvh.h"
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
@@ -182,5 +186,58 @@ TEST_SUITE("encode") {
     s = {};
     s.tension = 2.0f;
     CHECK_FALSE(encode(m, s, r, error));
+  }
+
+  TEST_CASE("the bytes do not depend on the number of threads") {
+    // A real clip (many channels, many rounds) when the corpus is there, else the arm.
+    Motion m = arm_motion(900);
+    for (const auto& f : keyanim::test::corpus_bvh_files())
+      if (f.filename() == "bvh11__131_01.bvh") {
+        BvhError err;
+        REQUIRE(read_bvh_file(f.string(), m, err));
+      }
+    for (double tol : {0.05, 0.5}) {
+      std::vector<uint8_t> first;
+      for (uint32_t threads : {1u, 2u, 3u, 0u}) {
+        EncodeSettings s;
+        s.tolerance = tol;
+        s.threads = threads;
+        EncodeResult r;
+        std::string error;
+        REQUIRE(encode(m, s, r, error));
+        const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level, threads);
+        CAPTURE(threads);
+        CAPTURE(tol);
+        if (first.empty()) first = bytes;
+        else CHECK(bytes == first);
+      }
+    }
+  }
+
+  // Skipped in the discovered tests; CTest runs it on its own with a timeout (tests/
+  // CMakeLists.txt), which anything quadratic in the depth (32,000 squared steps per frame, or
+  // a list of ancestors' channels per node: 6 GB) would overrun by far.
+  TEST_CASE("a chain of 32000 joints encodes in time linear in its depth" * doctest::skip()) {
+    constexpr uint32_t kJoints = 32000, kFrames = 6;
+    Motion m;
+    m.skeleton.joints.reserve(kJoints + 1);
+    for (uint32_t j = 0; j < kJoints; ++j)
+      m.skeleton.joints.push_back({"j" + std::to_string(j), int32_t(j) - 1, {0, j ? 1.0 : 0.0, 0},
+                                   {ChannelType::z_rotation, ChannelType::x_rotation, ChannelType::y_rotation}});
+    m.skeleton.joints.push_back({"", int32_t(kJoints) - 1, {0, 1, 0}, {}, true});
+    m.skeleton.assign_channel_columns();
+    m.frame_count = kFrames;
+    m.frame_time = 1.0 / 30.0;
+    m.values.resize(size_t(kFrames) * kJoints * 3);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> angle(-0.002, 0.002);  // the chain curls gently
+    for (double& v : m.values) v = angle(rng);
+    EncodeSettings s;
+    s.threads = 1;
+    EncodeResult r;
+    std::string error;
+    REQUIRE(encode(m, s, r, error));
+    CHECK(r.error.max_error <= r.tolerance_units);
+    CHECK(r.clip.channels.size() == size_t(kJoints) * 3);
   }
 }

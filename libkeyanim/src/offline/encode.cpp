@@ -86,7 +86,7 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
   parallel_for(refit.size(), job.threads, [&](size_t i, unsigned w) {
     const uint32_t c = refit[i];
     Worker& s = workers[w];
-    channel_signal(m, c, job.layout.rotation[c], s.fit.y);
+    channel_signal(m, job.layout, c, s.fit.y);
     const Tolerance tol = budgets.tolerance(c);
     const double step = budgets.step(c, kStepFraction);
     EncodedChannel fitted;

@@ -53,12 +53,12 @@ ChannelLayout channel_layout(const Skeleton& s) {
   return out;
 }
 
-void channel_signal(const Motion& m, uint32_t c, bool rotation, std::vector<double>& out) {
-  const size_t stride = m.channel_count();
+void channel_signal(const Motion& m, const ChannelLayout& layout, uint32_t c, std::vector<double>& out) {
+  const size_t stride = layout.node.size();  // not m.channel_count(): that walks the skeleton
   out.resize(m.frame_count);
   const double* v = m.values.data() + c;
   for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = v[size_t(f) * stride];
-  if (rotation) unwrap_degrees(out);
+  if (layout.rotation[c]) unwrap_degrees(out);
 }
 
 void unwrap_degrees(std::vector<double>& y) {

@@ -22,8 +22,9 @@ struct ChannelLayout {
 };
 ChannelLayout channel_layout(const Skeleton& skeleton);
 
-// Channel c of `motion` over every frame into `out`, unwrapped (unwrap_degrees) if it is a
-// rotation. Reads a column of the frame-major values: the encoder keeps no copy of them.
-void channel_signal(const Motion& motion, uint32_t c, bool rotation, std::vector<double>& out);
+// Channel c of `motion` (laid out as `layout` says) over every frame into `out`, unwrapped
+// (unwrap_degrees) if it is a rotation. Reads a column of the frame-major values: the encoder
+// keeps no copy of them.
+void channel_signal(const Motion& motion, const ChannelLayout& layout, uint32_t c, std::vector<double>& out);
 
 }  // namespace keyanim::offline

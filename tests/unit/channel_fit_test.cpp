@@ -1,0 +1,141 @@
+// Fitting one channel: the quantizer, the fits' guarantee checked with the runtime's own
+// evaluation, refits that continue from the keys, and the scratch a fit leaves behind.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "offline/channel_fit.h"
+
+using namespace keyanim;
+using namespace keyanim::offline;
+
+namespace {
+
+// Largest |decoded - y| / tol over the frames, decoding with eval_channel (cardinal.h).
+double worst_ratio(const EncodedChannel& ch, const std::vector<double>& y, Tolerance tol, TangentRule rule) {
+  std::vector<float> v;
+  for (int64_t q : ch.q) v.push_back(dequantize(q, ch.step));
+  double worst = 0.0;
+  for (uint32_t f = 0; f < y.size(); ++f) {
+    const float d = eval_channel(ch.frames.data(), v.data(), uint32_t(v.size()), float(f), ch.interp,
+                                 tension_to_s(ch.tension), rule);
+    worst = std::max(worst, std::fabs(double(d) - y[f]) / tol.at(f));
+  }
+  return worst;
+}
+
+std::vector<double> wavy(uint32_t frames, double phase) {
+  std::vector<double> y(frames);
+  for (uint32_t f = 0; f < frames; ++f) y[f] = 30.0 * std::sin(0.03 * f + phase) + 4.0 * std::sin(0.31 * f);
+  return y;
+}
+
+bool scratch_clean(const FitScratch& s) {
+  for (size_t f = 0; f < s.prev.size(); ++f)
+    if (s.prev[f] != CurveFit::kNone || s.next[f] != CurveFit::kNone || s.is_key[f]) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_SUITE("channel_fit") {
+  TEST_CASE("quantize is std::llround of y / step") {
+    std::mt19937_64 rng(3);
+    const double specials[] = {0.5, -0.5, 1.5, -2.5, 0.49999999999999994, -0.49999999999999994,
+                               4503599627370495.5, 9007199254740993.0, 1e18, -1e18, 0.0, -0.0, 1e-300};
+    for (double x : specials) CHECK(quantize(x, 1.0) == std::llround(x));
+    int wrong = 0;
+    for (int i = 0; i < 1000000; ++i) {
+      uint64_t bits = rng();
+      double x;
+      std::memcpy(&x, &bits, sizeof x);
+      if (!std::isfinite(x) || std::fabs(x) > 1e18) x = double(int64_t(rng() % 2000001) - 1000000) + 0.5;
+      const double step = 0.001 * double(1 + rng() % 1000);
+      wrong += quantize(x, step) != std::llround(x / step);
+    }
+    CHECK(wrong == 0);
+  }
+
+  TEST_CASE("a fit keeps every frame within its tolerance and leaves its scratch clean") {
+    const std::vector<double> y = wavy(500, 0.3);
+    std::vector<float> factor(500, 1.0f);
+    for (uint32_t f = 200; f < 260; ++f) factor[f] = 0.1f;  // tighter in the middle
+    const Tolerance tol{0.05, factor.data()};
+    for (bool linear : {false, true}) {
+      ChannelFitOptions opt;
+      opt.force_linear = linear;
+      ChannelFitter fitter(opt);
+      FitScratch scratch;
+      scratch.y = y;
+      // The step the encoder would pick: within 1.5 of the smallest tolerance (0.005), so that a
+      // key's own rounding stays inside its budget.
+      const EncodedChannel ch = fitter.fit(tol, 0.075 / 16, nullptr, scratch);
+      CHECK(ch.interp == (linear ? Interpolation::linear : Interpolation::cardinal));
+      CHECK(worst_ratio(ch, y, tol, TangentRule::step_adjusted) <= 1.0);
+      CHECK(ch.frames.size() > 2);
+      CHECK(ch.frames.size() < 450);  // far fewer keys than frames
+      CHECK(scratch_clean(scratch));
+    }
+  }
+
+  TEST_CASE("a refit continues from its keys: knowing where budgets changed gives the same keys") {
+    const std::vector<double> y = wavy(800, 1.1);
+    std::vector<float> factor(800, 1.0f);
+    const Tolerance tol{0.02, factor.data()};
+    ChannelFitter a{ChannelFitOptions{}}, b{ChannelFitOptions{}};
+    FitScratch scratch;
+    scratch.y = y;
+    const EncodedChannel first = a.fit(tol, 0.03, nullptr, scratch);
+    CHECK(b.fit(tol, 0.03, nullptr, scratch).frames == first.frames);
+    // Tighten a few frames, then refit: once told where, once not (every segment re-measured).
+    std::vector<uint32_t> changed{100, 101, 102, 450, 451, 799};
+    for (uint32_t f : changed) factor[f] = 0.8f;  // the step 0.03 stays within 1.5 of the tolerance
+    const EncodedChannel told = a.fit(tol, 0.03, &changed, scratch);
+    const EncodedChannel not_told = b.fit(tol, 0.03, nullptr, scratch);
+    CHECK(told.frames == not_told.frames);
+    CHECK(told.q == not_told.q);
+    CHECK(worst_ratio(told, y, tol, TangentRule::step_adjusted) <= 1.0);
+    CHECK(told.frames.size() >= first.frames.size());
+    // Tighter still, with a smaller step: every key is requantized.
+    for (uint32_t f : changed) factor[f] = 0.3f;
+    const EncodedChannel finer = a.fit(tol, 0.0075, &changed, scratch);
+    CHECK(finer.step == 0.0075);
+    CHECK(worst_ratio(finer, y, tol, TangentRule::step_adjusted) <= 1.0);
+    CHECK(scratch_clean(scratch));
+  }
+
+  TEST_CASE("constant channels cost one key, zero channels none") {
+    std::vector<float> factor(50, 1.0f);
+    const Tolerance tol{0.1, factor.data()};
+    std::vector<double> y(50, 0.04);
+    auto c = constant_channel(y.data(), 50, 0.04, 0.04, tol, 0.1);
+    REQUIRE(c.has_value());
+    CHECK(c->frames.empty());  // 0.04 rounds to the integer 0 at step 0.1, within 0.1
+    y.assign(50, 3.0);
+    c = constant_channel(y.data(), 50, 3.0, 3.0, tol, 0.1);
+    REQUIRE(c.has_value());
+    CHECK(c->frames == std::vector<uint32_t>{0});
+    CHECK(c->q == std::vector<int64_t>{30});
+    y[20] = 3.5;
+    CHECK_FALSE(constant_channel(y.data(), 50, 3.0, 3.5, tol, 0.1).has_value());
+  }
+
+  TEST_CASE("fixed keys are kept as given") {
+    const std::vector<double> y = wavy(100, 0.0);
+    std::vector<float> factor(100, 1.0f);
+    FitScratch scratch;
+    const std::vector<uint32_t> keys{0, 10, 55, 99};
+    const EncodedChannel ch = fit_channel_at_keys(y, keys, {0.01, factor.data()}, 0.01, ChannelFitOptions{}, scratch);
+    CHECK(ch.frames == keys);
+    for (size_t i = 0; i < keys.size(); ++i) CHECK(ch.q[i] == std::llround(y[keys[i]] / 0.01));
+    ChannelFitOptions fit;
+    fit.fit_tension = true;
+    const EncodedChannel fitted = fit_channel_at_keys(y, keys, {0.01, factor.data()}, 0.01, fit, scratch);
+    CHECK(fitted.frames == keys);
+    CHECK(fitted.tension >= -1.0f);
+    CHECK(fitted.tension <= 1.0f);
+    CHECK(scratch_clean(scratch));
+  }
+}

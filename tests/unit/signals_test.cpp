@@ -1,0 +1,78 @@
+// The encoder's input: what it refuses and why, and each channel as the fitter sees it.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "keyanim/offline/encode.h"
+#include "offline/signals.h"
+
+using namespace keyanim;
+using namespace keyanim::offline;
+
+namespace {
+
+Motion two_nodes(uint32_t frames) {
+  Motion m;
+  m.skeleton.joints = {{"Root", -1, {0, 0, 0}, {ChannelType::x_position, ChannelType::z_rotation}},
+                       {"", 0, {0, 2, 0}, {}, true}};
+  m.skeleton.assign_channel_columns();
+  m.frame_count = frames;
+  m.frame_time = 0.1;
+  m.values.assign(size_t(frames) * 2, 0.0);
+  return m;
+}
+
+}  // namespace
+
+TEST_SUITE("signals") {
+  TEST_CASE("check_motion accepts a plain motion and names what it refuses") {
+    Motion m = two_nodes(300);
+    for (unsigned threads : {1u, 2u}) CHECK(check_motion(m, threads).empty());
+    m.values.pop_back();
+    CHECK(check_motion(m, 1).find("expected frames x channels") != std::string::npos);
+    m = two_nodes(300);
+    m.values[7] = 2e37;
+    CHECK(check_motion(m, 1).find("binary32") != std::string::npos);
+    m = two_nodes(300);
+    m.values[7] = NAN;
+    CHECK(check_motion(m, 1).find("binary32") != std::string::npos);
+    // Values in range whose sum is not: a position beyond 1e37, found by FK at frame 299.
+    m = two_nodes(300);
+    m.skeleton.joints[1].offset = {9e36, 0, 0};
+    m.values[299 * 2] = 9e36;
+    for (unsigned threads : {1u, 2u}) CHECK(check_motion(m, threads).find("overflow") != std::string::npos);
+  }
+
+  TEST_CASE("channel layout and signals: a column, unwrapped when it is an angle") {
+    Motion m = two_nodes(4);
+    const double x[4] = {1.0, 2.0, 3.0, 4.0}, z[4] = {170.0, -170.0, -150.0, 179.0};
+    for (uint32_t f = 0; f < 4; ++f) m.values[f * 2] = x[f], m.values[f * 2 + 1] = z[f];
+    const ChannelLayout layout = channel_layout(m.skeleton);
+    CHECK(layout.node == std::vector<uint32_t>{0, 0});
+    CHECK(layout.rotation == std::vector<uint8_t>{0, 1});
+    std::vector<double> y;
+    channel_signal(m, layout, 0, y);
+    CHECK(y == std::vector<double>{1.0, 2.0, 3.0, 4.0});
+    channel_signal(m, layout, 1, y);
+    REQUIRE(y.size() == 4);
+    CHECK(y[0] == 170.0);
+    CHECK(y[1] == doctest::Approx(190.0));
+    CHECK(y[2] == doctest::Approx(210.0));
+    CHECK(y[3] == doctest::Approx(179.0));
+  }
+
+  TEST_CASE("unwrapping takes the shorter way at exactly 180 degrees as round() does") {
+    std::vector<double> y{0.0, 180.0, 359.0, -1.0};
+    unwrap_degrees(y);
+    // +180 rounds away from zero: -180; then +179; then -360 wraps to 0 (step 0).
+    CHECK(y == std::vector<double>{0.0, 0.0 + 180.0 - 360.0, -180.0 + 179.0, -1.0});
+  }
+
+  TEST_CASE("reference size falls back to the swept box of a skeleton with no extent") {
+    Motion m = two_nodes(3);
+    CHECK(reference_size(m) == 2.0);  // the rest pose: the End Site 2 above the root
+    m.skeleton.joints.pop_back();
+    m.values = {0.0, 0.0, 5.0, 0.0, -1.0, 0.0};  // the lone root moves from x -1 to 5
+    CHECK(reference_size(m) == 6.0);
+  }
+}

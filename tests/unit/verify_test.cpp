@@ -1,0 +1,231 @@
+// Verification against what a decoder reproduces: the encoder's channel decoding against the
+// runtime's sampler, the frames a refit can change against brute force, and window
+// verification against measure_error on the decoded motion.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "keyanim/offline/container.h"
+#include "keyanim/offline/decode.h"
+#include "keyanim/offline/metrics.h"
+#include "offline/verify.h"
+
+using namespace keyanim;
+using namespace keyanim::offline;
+
+namespace {
+
+// A random channel of `frames` frames: sorted distinct key frames, random integers.
+EncodedChannel random_channel(std::mt19937& rng, uint32_t frames, bool linear, uint32_t max_keys) {
+  EncodedChannel ch;
+  ch.interp = linear ? Interpolation::linear : Interpolation::cardinal;
+  ch.tension = linear ? 0.0f : float(rng() % 5) * 0.25f - 0.5f;
+  ch.step = 0.01 * double(1 + rng() % 4);
+  const uint32_t keys = std::min<uint32_t>(frames, uint32_t(rng() % (max_keys + 1)));
+  std::vector<uint32_t> pick(frames);
+  for (uint32_t f = 0; f < frames; ++f) pick[f] = f;
+  std::shuffle(pick.begin(), pick.end(), rng);
+  ch.frames.assign(pick.begin(), pick.begin() + keys);
+  std::sort(ch.frames.begin(), ch.frames.end());
+  for (size_t i = 0; i < ch.frames.size(); ++i) ch.q.push_back(int64_t(rng() % 2001) - 1000);
+  return ch;
+}
+
+// One channel in a clip of its own, sampled by the runtime at every frame.
+std::vector<float> sampled(const EncodedChannel& ch, uint32_t frames, TangentRule rule) {
+  EncodedClip clip;
+  clip.skeleton.joints = {{"J", -1, {0, 0, 0}, {ChannelType::x_position}}};
+  clip.skeleton.assign_channel_columns();
+  clip.frame_count = frames;
+  clip.frame_time = 0.1;
+  clip.tangent_rule = rule;
+  clip.channels = {ch};
+  REQUIRE(validate_encoded_clip(clip).empty());
+  const Clip c = to_clip(clip);
+  std::vector<float> out(frames);
+  for (uint32_t f = 0; f < frames; ++f) out[f] = c.sample_channel(0, float(f));
+  return out;
+}
+
+}  // namespace
+
+TEST_SUITE("verify") {
+  TEST_CASE("decoded channels are the runtime sampler's values, bit for bit") {
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 300; ++trial) {
+      const uint32_t frames = 1 + uint32_t(rng() % 60);
+      const TangentRule rule = trial % 2 ? TangentRule::uniform : TangentRule::step_adjusted;
+      const EncodedChannel ch = random_channel(rng, frames, trial % 3 == 0, 12);
+      const std::vector<float> want = sampled(ch, frames, rule);
+      std::vector<uint32_t> all(frames);
+      for (uint32_t f = 0; f < frames; ++f) all[f] = f;
+      std::vector<double> got(frames);
+      decode_channel_at(ch, rule, all.data(), frames, got.data(), 1);
+      // Every other frame too: the cursor skips frames.
+      std::vector<uint32_t> odd;
+      for (uint32_t f = 1; f < frames; f += 2) odd.push_back(f);
+      std::vector<double> got_odd(odd.size());
+      decode_channel_at(ch, rule, odd.data(), odd.size(), got_odd.data(), 1);
+      int wrong = 0;
+      for (uint32_t f = 0; f < frames; ++f) wrong += got[f] != double(want[f]);
+      for (size_t i = 0; i < odd.size(); ++i) wrong += got_odd[i] != double(want[odd[i]]);
+      CAPTURE(trial);
+      CHECK(wrong == 0);
+    }
+  }
+
+  TEST_CASE("changed ranges hold every frame whose decoded value differs") {
+    std::mt19937 rng(12);
+    int covered = 0, tight = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+      const uint32_t frames = 2 + uint32_t(rng() % 80);
+      EncodedChannel a = random_channel(rng, frames, trial % 7 == 0, 20);
+      // b: a with a few edits (keys added, removed, requantized), or something else entirely.
+      EncodedChannel b = a;
+      const int edits = 1 + int(rng() % 3);
+      for (int e = 0; e < edits; ++e) {
+        const uint32_t f = uint32_t(rng() % frames);
+        auto it = std::lower_bound(b.frames.begin(), b.frames.end(), f);
+        const size_t i = size_t(it - b.frames.begin());
+        if (it != b.frames.end() && *it == f) {
+          if (rng() % 2) b.frames.erase(it), b.q.erase(b.q.begin() + long(i));
+          else b.q[i] += 1;
+        } else {
+          b.frames.insert(it, f), b.q.insert(b.q.begin() + long(i), int64_t(rng() % 100));
+        }
+      }
+      if (trial % 11 == 0) b.step *= 0.5;
+      if (trial % 13 == 0) b.interp = Interpolation::linear;
+      const std::vector<float> va = sampled(a, frames, TangentRule::step_adjusted);
+      const std::vector<float> vb = sampled(b, frames, TangentRule::step_adjusted);
+      std::vector<std::pair<uint32_t, uint32_t>> ranges;
+      changed_ranges(a, b, frames, ranges);
+      std::vector<uint8_t> in(frames, 0);
+      for (size_t r = 0; r < ranges.size(); ++r) {
+        CHECK(ranges[r].first <= ranges[r].second);
+        CHECK(ranges[r].second < frames);
+        if (r > 0) CHECK(ranges[r - 1].second + 1 < ranges[r].first);  // increasing, disjoint, merged
+        for (uint32_t f = ranges[r].first; f <= ranges[r].second; ++f) in[f] = 1;
+      }
+      int missed = 0, marked = 0, differ = 0;
+      for (uint32_t f = 0; f < frames; ++f) {
+        const bool d = va[f] != vb[f];
+        missed += d && !in[f];
+        marked += in[f];
+        differ += d;
+      }
+      CAPTURE(trial);
+      CHECK(missed == 0);
+      covered += differ > 0;
+      tight += marked < int(frames);
+    }
+    CHECK(covered > 1000);  // the edits did change values
+    CHECK(tight > 1000);    // and the ranges are not simply everything
+  }
+
+  TEST_CASE("window verification finds exactly the nodes measure_error finds over") {
+    // A two-bone arm, its encoding at a coarse uniform key interval, and a tolerance between
+    // the smallest and largest errors: the over nodes are those the report says are over.
+    Motion m;
+    m.skeleton.joints = {{"Root", -1, {0, 0, 0}, {ChannelType::x_position, ChannelType::z_rotation}},
+                         {"Arm", 0, {0, 5, 0}, {ChannelType::z_rotation}},
+                         {"", 1, {0, 5, 0}, {}, true}};
+    m.skeleton.assign_channel_columns();
+    m.frame_count = 300;
+    m.frame_time = 1.0 / 30.0;
+    for (uint32_t f = 0; f < 300; ++f) {
+      const double t = f / 30.0;
+      m.values.insert(m.values.end(), {std::sin(t), 30.0 * std::sin(2.1 * t), 40.0 * std::cos(1.3 * t)});
+    }
+    EncodedClip clip;
+    clip.skeleton = m.skeleton;
+    clip.frame_count = 300;
+    clip.frame_time = m.frame_time;
+    for (uint32_t c = 0; c < 3; ++c) {
+      EncodedChannel ch;
+      ch.step = 0.001;
+      for (uint32_t f = 0; f < 300; f += 37) ch.frames.push_back(f), ch.q.push_back(std::llround(m.values[f * 3 + c] / 0.001));
+      clip.channels.push_back(ch);
+    }
+    Motion decoded;
+    std::string error;
+    REQUIRE(decode_motion(to_clip(clip), {}, decoded, error));
+    const ErrorReport report = measure_error(m, decoded);
+    const double tol = 0.5 * report.max_error;
+    FrameMarks marks(300, 3);
+    marks.mark_all();
+    std::vector<OverNode> over;
+    VerifyScratch scratch;
+    for (uint32_t first = 0; first < 300; first += 64)
+      verify_window(m, clip.channels, clip.tangent_rule, tol, first, std::min(64u, 300 - first), marks, over, scratch);
+    // Independently: FK of both motions, node by node.
+    std::vector<Vec3> a, b;
+    size_t want = 0, matched = 0;
+    for (uint32_t f = 0; f < 300; ++f) {
+      world_positions(m.skeleton, m.frame(f), a);
+      world_positions(m.skeleton, decoded.frame(f), b);
+      for (uint32_t d = 0; d < 3; ++d) {
+        const double e = std::hypot(a[d][0] - b[d][0], a[d][1] - b[d][1], a[d][2] - b[d][2]);
+        if (e <= tol) continue;
+        ++want;
+        for (const OverNode& o : over)
+          if (o.frame == f && o.node == d && o.error == doctest::Approx(e).epsilon(1e-12)) ++matched;
+      }
+    }
+    CHECK(want > 0);
+    CHECK(over.size() == want);
+    CHECK(matched == want);
+    // Marks: over frames stay marked for a full check; nothing else is.
+    for (uint32_t f = 0; f < 300; ++f) {
+      bool is_over = false;
+      for (const OverNode& o : over) is_over |= o.frame == f;
+      CHECK(marks.check()[f] == (is_over ? FrameMarks::kOver : 0));
+    }
+    // A frame marked as changed at the Arm only measures the Arm and its End Site.
+    FrameMarks some(300, 3);
+    some.mark(1, 10, 12);
+    std::vector<OverNode> only;
+    verify_window(m, clip.channels, clip.tangent_rule, 0.0, 0, 64, some, only, scratch);
+    for (const OverNode& o : only) {
+      CHECK(o.node != 0);
+      CHECK(o.frame >= 10);
+      CHECK(o.frame <= 12);
+    }
+    CHECK(only.size() >= 3);  // with a tolerance of 0, whatever moved is over
+  }
+
+  TEST_CASE("the final measurement is measure_error's report on the decoded motion") {
+    Motion m;
+    m.skeleton.joints = {{"Root", -1, {0, 0, 0}, {ChannelType::y_position, ChannelType::x_rotation}},
+                         {"", 0, {0, 0, 3}, {}, true}};
+    m.skeleton.assign_channel_columns();
+    m.frame_count = 700;  // several measurement windows
+    m.frame_time = 0.01;
+    for (uint32_t f = 0; f < 700; ++f) m.values.insert(m.values.end(), {0.01 * f, 20.0 * std::sin(f * 0.05)});
+    EncodedClip clip;
+    clip.skeleton = m.skeleton;
+    clip.frame_count = 700;
+    clip.frame_time = 0.01;
+    for (uint32_t c = 0; c < 2; ++c) {
+      EncodedChannel ch;
+      ch.step = 0.01;
+      for (uint32_t f = 0; f < 700; f += 50) ch.frames.push_back(f), ch.q.push_back(std::llround(m.values[f * 2 + c] / 0.01));
+      if (ch.frames.back() != 699) ch.frames.push_back(699), ch.q.push_back(std::llround(m.values[699 * 2 + c] / 0.01));
+      clip.channels.push_back(ch);
+    }
+    Motion decoded;
+    std::string error;
+    REQUIRE(decode_motion(to_clip(clip), {}, decoded, error));
+    const ErrorReport want = measure_error(m, decoded);
+    for (unsigned threads : {1u, 2u, 3u}) {
+      const ErrorReport got = measure_encoded(m, clip, threads);
+      CHECK(got.max_error == want.max_error);
+      CHECK(got.rms_error == want.rms_error);
+      CHECK(got.worst_frame == want.worst_frame);
+      CHECK(got.worst_joint == want.worst_joint);
+      CHECK(got.joint_max == want.joint_max);
+      CHECK(got.channel_max == want.channel_max);
+    }
+  }
+}
