@@ -1,7 +1,23 @@
 // Codec benchmark over the corpus: size against error, Cardinal against linear, keyanim against
-// ACL at equal error, and encode time against BVH parse time. Prints one JSON object.
+// ACL at equal error, encode time against BVH parse time, and, on long clips made from CMU
+// 01_01 (long_clip.h), the speedup of a second thread and the peak memory of an encode.
+// Prints one JSON object; the targets are the top-level fields
+//   encode_over_parse_1thread  median over the CMU 120 fps files of (encode + write) / parse,
+//                              one thread, CPU time of the thread (the machine may be shared)
+//   speedup_2threads           wall time of encode + write of an 11,008-frame clip, 1 thread over
+//                              2 (best of --reps runs each; noisy on a shared machine)
+//   peak_rss_over_bvh_bytes    peak RSS (getrusage of a child process that reads, parses, frees
+//                              the text, encodes and writes a 44,032-frame clip) over the BVH size
 //
-//   bench_codec [--tolerance 0.05%,0.5%] [--filter SUBSTRING] [--no-linear] [--fit]
+//   bench_codec [--tolerance 0.05%,0.5%] [--filter SUBSTRING] [--no-linear] [--fit] [--no-long]
+//               [--reps N]
+//   bench_codec --write-long FRAMES OUT.bvh     writes a long clip (e.g. 432000: one hour)
+#include <sys/resource.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +35,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/metrics.h"
+#include "long_clip.h"
 
 namespace fs = std::filesystem;
 using namespace keyanim;
@@ -27,6 +44,26 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// CPU time of this thread in ms: with one thread, what the work cost whatever else runs.
+double cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::string text(size_t(fs::file_size(p)), '\0');
+  in.read(text.data(), std::streamsize(text.size()));
+  return text;
+}
 
 struct AclRow {
   double threshold, bytes, max_err;
@@ -75,11 +112,12 @@ struct RunResult {
 
 RunResult run(const offline::Motion& m, offline::EncodeSettings s) {
   RunResult r;
-  const auto t0 = Clock::now();
+  s.threads = 1;
+  const double t0 = cpu_ms();
   offline::EncodeResult enc;
   if (!offline::encode(m, s, enc, r.error)) return r;
   const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, s.zstd_level);
-  r.encode_ms = ms_since(t0);
+  r.encode_ms = cpu_ms() - t0;
   // Measure on what a decoder makes of the bytes, not on the encoder's own view.
   Clip clip;
   ErrorInfo info;
@@ -96,15 +134,115 @@ RunResult run(const offline::Motion& m, offline::EncodeSettings s) {
   return r;
 }
 
+// Encode + write of `m` with `threads`, wall ms, best of `reps`.
+double encode_wall_ms(const offline::Motion& m, unsigned threads, int reps, size_t& bytes) {
+  double best = HUGE_VAL;
+  for (int r = 0; r < reps; ++r) {
+    offline::EncodeSettings s;
+    s.threads = threads;
+    const auto t0 = Clock::now();
+    offline::EncodeResult enc;
+    std::string error;
+    if (!offline::encode(m, s, enc, error)) {
+      std::cerr << "bench_codec: " << error << "\n";
+      return 0.0;
+    }
+    bytes = offline::write_kanim(enc.clip, s.zstd_level, threads).size();
+    best = std::min(best, ms_since(t0));
+  }
+  return best;
+}
+
+// The child of the memory measurement: what `keyanim encode` holds, in a fresh process.
+int rss_child(const std::string& path) {
+  offline::Motion m;
+  {
+    const std::string text = read_file(path);
+    offline::BvhError err;
+    if (!offline::read_bvh(text, path, m, err)) {
+      std::cerr << err.to_string() << "\n";
+      return 1;
+    }
+  }  // the text is freed before encoding, as the CLI does
+  offline::EncodeResult enc;
+  std::string error;
+  if (!offline::encode(m, {}, enc, error)) {
+    std::cerr << "bench_codec: " << error << "\n";
+    return 1;
+  }
+  m = {};  // and the motion before writing (zstd's tables at level 19 are tens of MB)
+  const size_t bytes = offline::write_kanim(enc.clip, 19).size();
+  std::cout << bytes << "\n";
+  return bytes ? 0 : 1;
+}
+
+// Peak RSS in bytes of `self --rss-child path`, from wait4's rusage (0 on failure).
+double child_peak_rss(const char* self, const std::string& path) {
+  const pid_t pid = fork();
+  if (pid < 0) return 0.0;
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    if (devnull >= 0) dup2(devnull, STDOUT_FILENO);
+    execl(self, self, "--rss-child", path.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return 0.0;
+  return double(usage.ru_maxrss) * 1024.0;  // kilobytes on Linux
+}
+
+// The long-clip figures: speedup of a second thread on 11,008 frames, peak RSS on 44,032.
+nlohmann::json long_clips(const char* self, const fs::path& corpus, int reps) {
+  const fs::path base = corpus / "cmu" / "assimp__01_01.bvh";
+  const std::string text = read_file(base);
+  offline::Motion m;
+  offline::BvhError err;
+  if (!offline::read_bvh(text, base.string(), m, err)) return {{"error", err.to_string()}};
+  nlohmann::json out = {{"source", "cmu/assimp__01_01.bvh"}};
+  const fs::path dir = fs::temp_directory_path();
+  {
+    const uint32_t frames = 4 * m.frame_count;
+    offline::Motion longer;
+    if (!offline::read_bvh(bench::long_bvh_text(text, m, frames), "long", longer, err)) return {{"error", err.to_string()}};
+    size_t b1 = 0, b2 = 0;
+    const double one = encode_wall_ms(longer, 1, reps, b1), two = encode_wall_ms(longer, 2, reps, b2);
+    out["speedup"] = {{"frames", frames}, {"ms_1thread", one}, {"ms_2threads", two}, {"same_bytes", b1 == b2},
+                      {"kanim_bytes", b1}};
+    out["speedup_2threads"] = two > 0 ? one / two : 0.0;
+  }
+  {
+    const uint32_t frames = 16 * m.frame_count;
+    const fs::path path = dir / ("keyanim_bench_" + std::to_string(getpid()) + "_long.bvh");
+    std::ofstream(path, std::ios::binary) << bench::long_bvh_text(text, m, frames);
+    const double bvh = double(fs::file_size(path));
+    const double rss = child_peak_rss(self, path.string());
+    fs::remove(path);
+    out["memory"] = {{"frames", frames}, {"bvh_bytes", bvh}, {"peak_rss_bytes", rss}};
+    out["peak_rss_over_bvh_bytes"] = rss > 0 ? rss / bvh : 0.0;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> tolerances{"0.05%", "0.5%"};
   std::string filter;
-  bool linear = true, fit = false;
-  uint32_t threads = 1;  // EncodeSettings' default; 0 = one per core, as the CLI does
+  bool linear = true, fit = false, long_runs = true;
+  int reps = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--rss-child" && i + 1 < argc) return rss_child(argv[i + 1]);
+    if (a == "--write-long" && i + 2 < argc) {
+      const fs::path base = fs::path(KEYANIM_CORPUS_DIR) / "cmu" / "assimp__01_01.bvh";
+      const std::string text = read_file(base);
+      offline::Motion m;
+      offline::BvhError err;
+      if (!offline::read_bvh(text, base.string(), m, err)) return std::cerr << err.to_string() << "\n", 1;
+      std::ofstream(argv[i + 2], std::ios::binary) << bench::long_bvh_text(text, m, uint32_t(std::stoul(argv[i + 1])));
+      return 0;
+    }
     if (a == "--tolerance" && i + 1 < argc) {
       tolerances.clear();
       std::stringstream ss(argv[++i]);
@@ -115,10 +253,13 @@ int main(int argc, char** argv) {
       linear = false;
     } else if (a == "--fit") {
       fit = true;
-    } else if (a == "--threads" && i + 1 < argc) {
-      threads = uint32_t(std::stoul(argv[++i]));
+    } else if (a == "--no-long") {
+      long_runs = false;
+    } else if (a == "--reps" && i + 1 < argc) {
+      reps = std::max(1, std::stoi(argv[++i]));
     } else {
-      std::cerr << "usage: bench_codec [--tolerance 0.05%,0.5%] [--filter S] [--no-linear] [--fit] [--threads N]\n";
+      std::cerr << "usage: bench_codec [--tolerance 0.05%,0.5%] [--filter S] [--no-linear] [--fit] [--no-long] [--reps N]\n"
+                   "       bench_codec --write-long FRAMES OUT.bvh\n";
       return 1;
     }
   }
@@ -133,7 +274,7 @@ int main(int argc, char** argv) {
     if (e.path().extension() == ".bvh" && e.path().string().find(filter) != std::string::npos) files.push_back(e.path());
   std::sort(files.begin(), files.end());
 
-  nlohmann::json out = {{"tolerances", tolerances}, {"threads", threads}, {"files", nlohmann::json::array()}};
+  nlohmann::json out = {{"tolerances", tolerances}, {"files", nlohmann::json::array()}};
   std::map<std::string, std::vector<double>> speed;  // tolerance -> encode/parse of each CMU file
   std::map<std::string, std::map<std::string, double>> totals;  // tolerance -> sums
   for (const fs::path& p : files) {
@@ -143,9 +284,9 @@ int main(int argc, char** argv) {
     offline::BvhError err;
     std::vector<double> parse_ms;
     for (int rep = 0; rep < 3; ++rep) {
-      const auto t0 = Clock::now();
+      const double t0 = cpu_ms();
       if (!offline::read_bvh(text, p.string(), m, err)) break;
-      parse_ms.push_back(ms_since(t0));
+      parse_ms.push_back(cpu_ms() - t0);
     }
     if (parse_ms.size() != 3) {
       out["files"].push_back({{"file", p.filename().string()}, {"error", err.to_string()}});
@@ -168,7 +309,6 @@ int main(int argc, char** argv) {
       s.tolerance_in_percent = tol.back() == '%';
       s.tolerance = std::stod(s.tolerance_in_percent ? tol.substr(0, tol.size() - 1) : tol);
       s.fit_tension = fit;
-      s.threads = threads;
       const RunResult c = run(m, s);
       nlohmann::json r = {{"tolerance", tol}, {"ok", c.ok}};
       if (!c.ok) {
@@ -226,6 +366,14 @@ int main(int argc, char** argv) {
                     {"max_encode_over_parse", t["max_encode_over_parse"]}};
   }
   out["summary_cmu_120fps"] = summary;
+  out["encode_over_parse_1thread"] = summary.contains(tolerances[0]) ? summary[tolerances[0]]["median_encode_over_parse"] : nlohmann::json(nullptr);
+  out["encode_over_parse_tolerance"] = tolerances[0];
+  if (long_runs) {
+    out["long_clips"] = long_clips(argv[0], corpus, reps);
+    out["speedup_2threads"] = out["long_clips"].value("speedup_2threads", 0.0);
+    out["peak_rss_over_bvh_bytes"] = out["long_clips"].value("peak_rss_over_bvh_bytes", 0.0);
+  }
+  out["targets"] = {{"encode_over_parse_1thread", "<= 20"}, {"speedup_2threads", ">= 1.7"}, {"peak_rss_over_bvh_bytes", "<= 3"}};
   std::cout << out.dump(1) << "\n";
   return 0;
 }

@@ -50,7 +50,7 @@ Encoded encode_one(const std::string& in, const std::string& out, const offline:
   offline::EncodeResult result;
   std::string error;
   if (!offline::encode(motion, settings, result, error)) fail(kBadInput, in + ": " + error);
-  const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level);
+  const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
   if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const double raw = 4.0 * motion.frame_count * motion.channel_count();
