@@ -9,7 +9,9 @@
 #include "keyanim/offline/container.h"
 #include "batch.h"
 #include "escape.h"
+#include "encode_one.h"
 #include "io.h"
+#include "manifest.h"
 #include "report.h"
 #include "settings.h"
 
@@ -26,30 +28,37 @@ const char* const kEncodeHelp =
     "                        would collide (m.bvh and m.BVH), exist (without -f) or are inputs\n"
     "                        stop the run before any file is encoded.\n"
     "  -j N                  threads (default and most: one per core): a file's channels, or\n"
-    "                        a directory's files\n"
+    "                        a directory's (or a manifest's) files\n"
+    "      keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing] [--report R.jsonl]\n"
+    "  --manifest LIST       encode every path listed (one per line; '-': standard input) to the\n"
+    "                        same path below OUTDIR, as .kanim (an absolute path loses its root)\n"
+    "  --shard I/N           only entries I, I+N, I+2N, ... (0 <= I < N): N machines, no coordination\n"
+    "  --skip-existing       skip an input whose output exists and loads as a valid file\n"
+    "  --report R.jsonl      append one JSON line per finished input: input, output, status\n"
+    "                        (ok, skipped, failed), bytes, max_error, tolerance, seconds\n"
     "  --json                one JSON object on standard output (not with -o -); names that\n"
     "                        are not UTF-8 keep their bytes as \\udcHH escapes\n";
 
-namespace {
-
-struct Encoded {
-  nlohmann::json summary;  // also what the human line says
-  std::string warning;     // --error exceeded in a key mode that does not apply it
-};
-
 // Encodes one file. Every check that needs no work comes first (input, output, options against
-// the input); the output is written only when everything else has succeeded.
+// the input); the output is written only when everything else has succeeded. Memory: the BVH
+// text goes once parsed, the motion's values once encoded.
 Encoded encode_one(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
                    bool error_given, const Globals& g) {
   Input input(in, g);
   Output output(out, true, g, ids_of({&input}));
-  const std::vector<uint8_t> bvh_bytes = input.read(Kind::bvh);
-  const offline::Motion motion = load_bvh_bytes(in, bvh_bytes, g);
+  offline::Motion motion;
+  size_t bvh_size = 0;
+  {
+    const std::vector<uint8_t> bvh_bytes = input.read(Kind::bvh);
+    bvh_size = bvh_bytes.size();
+    motion = load_bvh_bytes(in, bvh_bytes, g);
+  }
   check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
   offline::EncodeResult result;
   std::string error;
   if (!offline::encode(motion, settings, result, error)) fail(kBadInput, in + ": " + error);
+  std::vector<double>().swap(motion.values);
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
   if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -62,7 +71,7 @@ Encoded encode_one(const std::string& in, const std::string& out, const offline:
       {"channels", motion.channel_count()},
       {"frame_time", motion.frame_time},
       {"keys", result.total_keys},
-      {"bvh_bytes", bvh_bytes.size()},
+      {"bvh_bytes", bvh_size},
       {"raw_f32_bytes", static_cast<uint64_t>(raw)},
       {"kanim_bytes", bytes.size()},
       {"ratio_raw_f32", raw / double(bytes.size())},
@@ -81,6 +90,8 @@ Encoded encode_one(const std::string& in, const std::string& out, const offline:
   output.commit();
   return e;
 }
+
+namespace {
 
 std::string human_line(const nlohmann::json& j) {
   std::ostringstream line;
@@ -138,9 +149,14 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
 }  // namespace
 
 int cmd_encode(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "-j"};
+  std::set<std::string> valued{"-o", "--output", "-j"}, flags{"--json"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
-  const Args args(argv, valued, {"--json"});
+  valued.insert(std::begin(kManifestValuedOptions), std::end(kManifestValuedOptions));
+  flags.insert(std::begin(kManifestFlags), std::end(kManifestFlags));
+  const Args args(argv, valued, flags);
+  if (args.has("--manifest")) return encode_manifest(args, encode_settings(args), g);
+  for (const char* o : {"--shard", "--report", "--skip-existing"})
+    if (args.has(o)) fail(kUsage, std::string(o) + " goes with --manifest LIST");
   if (args.positional().size() != 1) fail(kUsage, "encode takes one input file or directory");
   offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];

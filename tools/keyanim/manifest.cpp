@@ -1,0 +1,183 @@
+#include "manifest.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "batch.h"
+#include "encode_one.h"
+#include "keyanim/clip.h"
+
+namespace keyanim::cli {
+namespace fs = std::filesystem;
+
+Shard parse_shard(const std::string& text) {
+  Shard s;
+  const size_t slash = text.find('/');
+  auto number = [&](std::string_view part, uint64_t& out) {
+    const auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), out);
+    return ec == std::errc() && p == part.data() + part.size() && !part.empty();
+  };
+  const std::string_view all(text);
+  if (slash == std::string::npos || !number(all.substr(0, slash), s.index) || !number(all.substr(slash + 1), s.count) ||
+      s.count == 0 || s.index >= s.count)
+    fail(kUsage, "--shard expects I/N with 0 <= I < N, got '" + text + "'");
+  return s;
+}
+
+std::vector<std::string> manifest_entries(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) out.push_back(line);
+  }
+  return out;
+}
+
+std::string mirrored_output(const std::string& input, const std::string& outdir) {
+  fs::path p = fs::path(input).lexically_normal();
+  if (p.is_relative() && !p.empty() && *p.begin() == "..") p = fs::absolute(p).lexically_normal();
+  if (p.is_absolute()) p = p.relative_path();
+  return (fs::path(outdir) / p).replace_extension(".kanim").string();
+}
+
+namespace {
+
+// The report: one JSON line per finished input, each appended by a single write() to a file
+// opened with O_APPEND, so that lines from several processes never interleave (on a local
+// file system; on NFS give each process its own report).
+class Report {
+ public:
+  explicit Report(const std::string& path) : path_(path) {
+    if (path.empty()) return;
+    std::error_code ec;  // in OUTDIR, say, not made yet
+    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path(), ec);
+    fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
+    if (fd_ < 0) fail(kOutputFailed, path + ": cannot open the report: " + std::strerror(errno));
+  }
+  ~Report() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  void add(const nlohmann::json& line) {
+    if (fd_ < 0) return;
+    const std::string text = line.dump() + "\n";
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ssize_t n = ::write(fd_, text.data(), text.size());
+    if (n != ssize_t(text.size())) fail(kOutputFailed, path_ + ": cannot append to the report: " + std::strerror(errno));
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::mutex mutex_;
+};
+
+// Inputs already in the report as done (ok or skipped): a resumed run does not list them again.
+std::set<std::string> reported_done(const std::string& path) {
+  std::set<std::string> done;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);  // a torn last line is skipped
+    if (j.is_object() && j.contains("input") && j["input"].is_string() &&
+        (j.value("status", "") == "ok" || j.value("status", "") == "skipped"))
+      done.insert(j["input"].get<std::string>());
+  }
+  return done;
+}
+
+// The max_error= line of an existing output's notes, or null.
+nlohmann::json noted_error(const Clip& clip) {
+  const std::string& notes = clip.encoder_notes();
+  const size_t at = notes.find("max_error=");
+  if (at == std::string::npos) return nullptr;
+  double v = 0.0;
+  const char* p = notes.data() + at + 10;
+  const auto [end, ec] = std::from_chars(p, notes.data() + notes.size(), v);
+  return ec == std::errc() ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+int encode_manifest(const Args& args, const offline::EncodeSettings& settings, Globals& g) {
+  if (!args.positional().empty()) fail(kUsage, "encode --manifest takes no input file: the list names them");
+  const std::string list = *args.get("--manifest");
+  const std::string outdir = args.get("-o").value_or(args.get("--output").value_or(""));
+  if (outdir.empty() || outdir == "-") fail(kUsage, "encode --manifest needs -o OUTDIR");
+  const Shard shard = parse_shard(args.get("--shard").value_or("0/1"));
+  const bool skip_existing = args.has("--skip-existing");
+  const std::string report_path = args.get("--report").value_or("");
+
+  std::string text;
+  if (list == "-") {
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+  } else {
+    std::ifstream in(list, std::ios::binary);
+    if (!in) fail(kBadInput, list + ": cannot open the list: " + std::strerror(errno));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::vector<std::string> all = manifest_entries(text);
+  std::vector<std::string> inputs;
+  for (uint64_t i = shard.index; i < all.size(); i += shard.count) inputs.push_back(all[size_t(i)]);
+  const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
+  Report report(report_path);
+
+  Globals quiet = g;
+  quiet.verbosity = std::min(g.verbosity, 1);
+  offline::EncodeSettings one = settings;
+  one.threads = 1;  // files in parallel, each on one thread
+  const int code = run_batch(inputs.size(), thread_count(args), g, [&](size_t i) {
+    const std::string& in = inputs[i];
+    const std::string out = mirrored_output(in, outdir);
+    const auto t0 = std::chrono::steady_clock::now();
+    nlohmann::json line = {{"input", in}, {"output", out}};
+    try {
+      std::error_code ec;
+      Globals mine = quiet;
+      if (skip_existing && fs::exists(out, ec)) {
+        Clip clip;
+        if (Clip::load_file(out, clip) == Status::ok) {
+          line.update({{"status", "skipped"}, {"bytes", fs::file_size(out, ec)}, {"max_error", noted_error(clip)},
+                       {"seconds", seconds_since(t0)}});
+          if (!done.count(in)) report.add(line);
+          return;
+        }
+        mine.force = true;  // damaged or incomplete: replaced
+      }
+      fs::create_directories(fs::path(out).parent_path(), ec);
+      if (ec) fail(kOutputFailed, fs::path(out).parent_path().string() + ": cannot create: " + ec.message());
+      const nlohmann::json r = encode_one(in, out, one, args.has("--error"), mine).summary;
+      line.update({{"status", "ok"}, {"bytes", r["kanim_bytes"]}, {"max_error", r["error"]["max"]},
+                   {"tolerance", r.value("tolerance", r.value("error_limit", 0.0))}, {"seconds", seconds_since(t0)}});
+      report.add(line);
+    } catch (const Failure& f) {
+      line.update({{"status", "failed"}, {"exit", f.code}, {"message", f.message}, {"seconds", seconds_since(t0)}});
+      report.add(line);
+      throw;
+    } catch (const std::exception& e) {  // out of memory, say: still one line, then run_batch reports it
+      line.update({{"status", "failed"}, {"exit", int(kBadInput)}, {"message", in + ": " + e.what()},
+                   {"seconds", seconds_since(t0)}});
+      report.add(line);
+      throw;
+    }
+  }, inputs);
+  return code;
+}
+
+}  // namespace keyanim::cli
