@@ -5,14 +5,17 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "batch.h"
+#include "eval_report.h"
 #include "commands.h"
 #include "escape.h"
 #include "io.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/metrics.h"
 #include "report.h"
 #include "settings.h"
@@ -20,13 +23,18 @@
 namespace keyanim::cli {
 
 const char* const kEvalHelp =
-    "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--keys MODE] [--tension T|fit] [--level N]\n"
-    "                    [-j N] [--json]\n"
+    "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--keys MODE[+MODE...]] [--tension T|fit]\n"
+    "                    [--level N] [-j N] [--json] [--svg RD.svg] [--report R.jsonl]\n"
     "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
     "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
     "by zstd -19, the max and RMS world-space error with the worst joint and frame, and the\n"
     "encode and decode times. Nothing is written.\n"
     "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
+    "  --keys A+B+...        several key modes (each as below), every one at every tolerance\n"
+    "  --svg RD.svg          compression ratio against error, log axes: a line per file, or\n"
+    "                        with several key modes a line per mode over every file\n"
+    "  --report R.jsonl      the figures as JSON lines, one per file and setting, then a total\n"
+    "                        per setting with the bytes per second of motion over every file\n"
     "  -j N                  threads (default: one per core)\n"
     "  --json                one JSON object on standard output\n"
     "With --keys other than error, --error only guides quantization: the error reached is\n"
@@ -43,19 +51,21 @@ size_t zstd19_size(const std::vector<uint8_t>& text) {
   return ZSTD_isError(n) ? 0 : n;
 }
 
-nlohmann::json eval_file(const std::string& path, const std::vector<offline::EncodeSettings>& runs,
-                         const std::vector<std::string>& labels, const Globals& g) {
+nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& runs, const Globals& g) {
   const std::vector<uint8_t> text = read_input(path, Kind::bvh, g);
   const auto t0 = Clock::now();
   const offline::Motion m = load_bvh_bytes(path, text, g);
-  check_settings_for(runs.front(), m, path);
+  for (const EvalRun& run : runs) check_settings_for(run.settings, m, path);
   const double parse_ms = ms(t0);
   const double raw = 4.0 * m.frame_count * m.channel_count();
   const size_t z19 = zstd19_size(text);
+  const double size = offline::reference_size(m);
   nlohmann::json file = {{"file", path},
                          {"frames", m.frame_count},
                          {"channels", m.channel_count()},
                          {"frame_time", m.frame_time},
+                         {"seconds", m.frame_count * m.frame_time},
+                         {"size", size},
                          {"raw_f32_bytes", raw},
                          {"bvh_bytes", text.size()},
                          {"bvh_zstd19_bytes", z19},
@@ -65,8 +75,9 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
     const auto te = Clock::now();
     offline::EncodeResult enc;
     std::string error;
-    if (!offline::encode(m, runs[r], enc, error)) fail(kBadInput, path + ": " + error);
-    const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, runs[r].zstd_level);
+    const offline::EncodeSettings& settings = runs[r].settings;
+    if (!offline::encode(m, settings, enc, error)) fail(kBadInput, path + ": " + error);
+    const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, settings.zstd_level);
     const double encode_ms = ms(te);
     const auto td = Clock::now();
     const Clip clip = load_kanim(path + " (encoded)", bytes, g);
@@ -75,7 +86,9 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
     const double decode_ms = ms(td);
     const offline::ErrorReport e = offline::measure_error(m, back);
     const double n = double(bytes.size());
-    nlohmann::json result = {{"keys", enc.total_keys},
+    nlohmann::json result = {{"key_mode", runs[r].keys},
+                      {"max_error_percent", size > 0 ? 100.0 * e.max_error / size : 0.0},
+                      {"keys", enc.total_keys},
                       {"kanim_bytes", bytes.size()},
                       {"ratio_raw_f32", raw / n},
                       {"ratio_bvh", double(text.size()) / n},
@@ -84,14 +97,14 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
                       {"encode_ms", encode_ms},
                       {"decode_ms", decode_ms}};
     // Only error mode applies the tolerance; the other modes say whether --error held.
-    if (runs[r].key_mode == offline::KeyMode::error) {
-      result["tolerance"] = labels[r];
+    if (settings.key_mode == offline::KeyMode::error) {
+      result["tolerance"] = runs[r].tolerance;
       result["tolerance_units"] = enc.tolerance_units;
     } else {
-      result["error_limit"] = labels[r];
+      result["error_limit"] = runs[r].tolerance;
       result["error_limit_units"] = enc.tolerance_units;
       result["error_limit_met"] = e.max_error <= enc.tolerance_units;
-      result["warning"] = tolerance_warning(runs[r], enc.tolerance_units, e.max_error);
+      result["warning"] = tolerance_warning(settings, enc.tolerance_units, e.max_error);
     }
     file["results"].push_back(std::move(result));
   }
@@ -101,33 +114,27 @@ nlohmann::json eval_file(const std::string& path, const std::vector<offline::Enc
 }  // namespace
 
 int cmd_eval(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-j"};
+  std::set<std::string> valued{"-j", "--svg", "--report"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {"--json"});
   if (args.positional().empty()) fail(kUsage, "eval needs at least one BVH file or directory");
   if (std::count(args.positional().begin(), args.positional().end(), "-") > 1)
     fail(kUsage, "only one input can be standard input");
-  std::vector<std::string> labels{"0.05%", "0.5%"};
-  if (auto list = args.get("--error")) {
-    labels.clear();
-    std::stringstream ss(*list);
-    for (std::string t; std::getline(ss, t, ',');) labels.push_back(t);
-    if (labels.empty()) fail(kUsage, "--error needs at least one tolerance");
-  }
-  std::vector<offline::EncodeSettings> runs;
-  for (const std::string& label : labels) {
-    offline::EncodeSettings s = encode_settings(args, false);  // --keys, --tension, --level
-    parse_tolerance(label, s);
-    if (const std::string why = s.validate(); !why.empty()) fail(kUsage, why);
-    runs.push_back(s);
-  }
+  const std::vector<EvalRun> runs = eval_runs(args);
   const std::vector<std::string> files = expand_inputs(args.positional());
   if (files.empty()) fail(kBadInput, "no .bvh files found");
+  // The figure and the report are checked (and their temporary files opened) before the work.
+  std::vector<FileId> ids;
+  for (const std::string& f : files)
+    if (auto id = input_id(f)) ids.push_back(*id);
+  std::optional<Output> svg, report;
+  if (auto path = args.get("--svg")) svg.emplace(*path, false, g, ids);
+  if (auto path = args.get("--report")) report.emplace(*path, false, g, ids);
   std::vector<nlohmann::json> results(files.size());
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
   const int code = run_batch(files.size(), thread_count(args), g,
-                             [&](size_t i) { results[i] = eval_file(files[i], runs, labels, quiet); }, files);
+                             [&](size_t i) { results[i] = eval_file(files[i], runs, quiet); }, files);
 
   // Warnings only when --error was given: the default list is not a request.
   for (auto& f : results) {
@@ -140,6 +147,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
       r.erase("warning");
     }
   }
+  if (svg) svg->write(eval_svg(results)), svg->commit();
+  if (report) report->write(eval_jsonl(results)), report->commit();
   if (args.has("--json")) {
     nlohmann::json all = nlohmann::json::array();
     for (const auto& r : results)
@@ -147,7 +156,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
     std::cout << json_text({{"files", all}}) << "\n";
     return code;
   }
-  const bool applied = runs.front().key_mode == offline::KeyMode::error;  // else --error is not a tolerance
+  const bool applied = runs.front().settings.key_mode == offline::KeyMode::error;  // else --error is not a tolerance
+  const bool modes = runs.front().keys != runs.back().keys;  // several key modes: say which
   std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s\n", "file", applied ? "tolerance" : "--error", "keys",
               "bytes", "x raw", "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms");
   for (const auto& f : results) {
@@ -156,7 +166,9 @@ int cmd_eval(const Argv& argv, Globals& g) {
     if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
     for (const auto& r : f["results"])
       std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f\n", name.c_str(),
-                  printable(r[applied ? "tolerance" : "error_limit"].get<std::string>()).c_str(),
+                  printable((modes ? r["key_mode"].get<std::string>() + " " : std::string()) +
+                            r[r.contains("tolerance") ? "tolerance" : "error_limit"].get<std::string>())
+                      .c_str(),
                   r["keys"].get<unsigned long long>(), r["kanim_bytes"].get<unsigned long long>(),
                   r["ratio_raw_f32"].get<double>(), r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(),
                   r["error"]["max"].get<double>(), r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(),

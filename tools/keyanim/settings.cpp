@@ -57,10 +57,10 @@ void check_settings_for(const offline::EncodeSettings& s, const offline::Motion&
     fail(kUsage, path + ": --keys manual: " + error);
 }
 
-offline::EncodeSettings encode_settings(const Args& args, bool read_error) {
+offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool read_keys) {
   offline::EncodeSettings s;
   if (auto e = args.get("--error"); e && read_error) parse_tolerance(*e, s);
-  if (auto k = args.get("--keys")) parse_key_mode(*k, s);
+  if (auto k = args.get("--keys"); k && read_keys) parse_key_mode(*k, s);
   if (auto t = args.get("--tension")) {
     if (*t == "fit") {
       s.fit_tension = true;

@@ -12,8 +12,9 @@ namespace keyanim::cli {
 inline const char* const kEncodeValuedOptions[] = {"--error", "--keys", "--tension", "--level"};
 
 // Reads the options (with their documented defaults) and validates them: usage error if wrong.
-// read_error = false leaves --error to the caller (eval takes a list).
-offline::EncodeSettings encode_settings(const Args& args, bool read_error = true);
+// read_error = false leaves --error to the caller (eval takes a list), read_keys = false
+// --keys (eval takes several modes).
+offline::EncodeSettings encode_settings(const Args& args, bool read_error = true, bool read_keys = true);
 // "0.05%" or "0.1" -> settings.tolerance / tolerance_in_percent; usage error if malformed.
 void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option = "--error");
 // "error", "uniform:N", "manual:F1,F2,...", "curvature".

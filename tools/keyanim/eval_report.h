@@ -1,0 +1,34 @@
+// What `keyanim eval` runs, and its figures as a rate-distortion SVG (--svg) and as JSON lines
+// with totals over the inputs (--report).
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "keyanim/offline/encode.h"
+
+namespace keyanim::cli {
+
+// One encoding setting of an eval: a key mode at a tolerance (its results carry both, as
+// "tolerance" and "key_mode").
+struct EvalRun {
+  std::string tolerance;  // as given: "0.05%" or "0.1"
+  std::string keys;       // as given: "error", "uniform:10", ...
+  offline::EncodeSettings settings;
+};
+
+// Every tolerance of --error (comma-separated, default 0.05%,0.5%) for every key mode of
+// --keys (several joined by '+', default error), modes first; usage error if one is wrong.
+std::vector<EvalRun> eval_runs(const Args& args);
+
+// The per-file results of eval (as --json prints them) as the RD figure: one line per file,
+// or, with several key modes, one line per mode over every file (its largest error and its
+// total ratio at each tolerance).
+std::string eval_svg(const std::vector<nlohmann::json>& files);
+
+// The same figures as JSON lines: one per file and run, then one total per run ("total":
+// true) with the bytes per second of motion over every file (seconds = frames x frame time).
+std::string eval_jsonl(const std::vector<nlohmann::json>& files);
+
+}  // namespace keyanim::cli
