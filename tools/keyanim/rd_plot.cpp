@@ -70,34 +70,14 @@ std::string rd_plot(const std::vector<RdSeries>& series, const std::string& subt
   doc.text({area.x, 24}, "Compression against error", attr("class", "title") + " font-size=\"15\" font-weight=\"bold\"");
   doc.text({area.x, 44}, subtitle, attr("class", "subtitle") + " fill=\"#444\"");
 
-  // Log axes: grid and tick marks at the tick values, labels in plain numbers.
-  const double left = area.x, right = area.x + area.w, top = area.y, bottom = area.y + area.h;
-  std::string grid, ticks;
-  const std::vector<double> xt = log_ticks(xr), yt = log_ticks(yr);
-  for (const double v : xt) {
-    const std::string x = number(axes.px(std::log10(v)));
-    grid += "M" + x + "," + number(top) + "V" + number(bottom);
-    ticks += "M" + x + "," + number(bottom) + "v5";
-  }
-  for (const double v : yt) {
-    const std::string y = number(axes.py(std::log10(v)));
-    grid += "M" + number(left) + "," + y + "H" + number(right);
-    ticks += "M" + number(left) + "," + y + "h-5";
-  }
-  doc.open_group(attr("class", "axes"));
-  doc.path_data(grid, attr("class", "grid") + " fill=\"none\" stroke=\"#e6e6e6\" stroke-width=\"1\"");
-  doc.line({left, bottom}, {right, bottom}, attr("class", "axis x-axis") + " stroke=\"#222\"");
-  doc.line({left, bottom}, {left, top}, attr("class", "axis y-axis") + " stroke=\"#222\"");
-  doc.path_data(ticks, attr("class", "ticks") + " fill=\"none\" stroke=\"#222\"");
-  doc.open_group(attr("class", "tick-labels") + " fill=\"#222\" font-size=\"11\"");
-  for (const double v : xt) doc.text({axes.px(std::log10(v)), bottom + 17}, tick_text(v), "", "middle");
-  for (const double v : yt) doc.text({left - 8, axes.py(std::log10(v)) + 4}, tick_text(v), "", "end");
-  doc.close_group();
-  doc.text({left + area.w / 2, bottom + 38}, "max error (% of the skeleton size, log scale)",
-           attr("class", "label x-label"), "middle");
-  doc.text({left - 56, top + area.h / 2}, "compression ratio (raw float32 / .kanim bytes, log scale)",
-           attr("class", "label y-label"), "middle", -90.0);
-  doc.close_group();
+  // Log axes: drawn over the exponents, labelled with the values.
+  auto ticks = [](svg::Range r) {
+    std::vector<svg::Axes::Tick> out;
+    for (const double v : log_ticks(r)) out.push_back({std::log10(v), tick_text(v)});
+    return out;
+  };
+  axes.draw(doc, "max error (% of the skeleton size, log scale)",
+            "compression ratio (raw float32 / .kanim bytes, log scale)", ticks(xr), ticks(yr));
 
   std::vector<svg::LegendEntry> legend;
   for (size_t s = 0; s < series.size(); ++s) {

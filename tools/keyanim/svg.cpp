@@ -168,23 +168,27 @@ Axes::Axes(Rect area, Range x, Range y) : area_(area), x_(x), y_(y) {
 void Axes::draw(Document& doc, const std::string& x_label, const std::string& y_label, int x_ticks,
                 int y_ticks) const {
   const std::vector<double> xt = nice_ticks(x_, x_ticks), yt = nice_ticks(y_, y_ticks);
-  const double left = area_.x, right = area_.x + area_.w, top = area_.y, bottom = area_.y + area_.h;
   // Decimals enough to tell neighbouring ticks apart.
-  auto decimals = [](const std::vector<double>& t) {
-    if (t.size() < 2) return 2;
-    const double step = t[1] - t[0];
-    return std::clamp(static_cast<int>(std::ceil(-std::log10(step) - 1e-9)), 0, 6);
+  auto labelled = [](const std::vector<double>& t) {
+    const int d = t.size() < 2 ? 2 : std::clamp(static_cast<int>(std::ceil(-std::log10(t[1] - t[0]) - 1e-9)), 0, 6);
+    std::vector<Tick> out;
+    for (const double v : t) out.push_back({v, number(v, d)});
+    return out;
   };
-  const int xd = decimals(xt), yd = decimals(yt);
+  draw(doc, x_label, y_label, labelled(xt), labelled(yt));
+}
 
+void Axes::draw(Document& doc, const std::string& x_label, const std::string& y_label, const std::vector<Tick>& xt,
+                const std::vector<Tick>& yt) const {
+  const double left = area_.x, right = area_.x + area_.w, top = area_.y, bottom = area_.y + area_.h;
   std::string grid, ticks;  // disjoint segments, one path each
-  for (const double t : xt) {
-    const std::string x = number(px(t));
+  for (const Tick& t : xt) {
+    const std::string x = number(px(t.at));
     append(grid, 'M', x, ',', number(top), 'V', number(bottom));
     append(ticks, 'M', x, ',', number(bottom), "v5");
   }
-  for (const double t : yt) {
-    const std::string y = number(py(t));
+  for (const Tick& t : yt) {
+    const std::string y = number(py(t.at));
     append(grid, 'M', number(left), ',', y, 'H', number(right));
     append(ticks, 'M', number(left), ',', y, "h-5");
   }
@@ -194,8 +198,8 @@ void Axes::draw(Document& doc, const std::string& x_label, const std::string& y_
   doc.line({left, bottom}, {left, top}, attr("class", "axis y-axis") + " stroke=\"#222\" stroke-width=\"1\"");
   doc.path_data(ticks, attr("class", "ticks") + " fill=\"none\" stroke=\"#222\" stroke-width=\"1\"");
   doc.open_group(attr("class", "tick-labels") + " fill=\"#222\" font-size=\"11\"");
-  for (const double t : xt) doc.text({px(t), bottom + 17.0}, number(t, xd), "", "middle");
-  for (const double t : yt) doc.text({left - 8.0, py(t) + 4.0}, number(t, yd), "", "end");
+  for (const Tick& t : xt) doc.text({px(t.at), bottom + 17.0}, t.label, "", "middle");
+  for (const Tick& t : yt) doc.text({left - 8.0, py(t.at) + 4.0}, t.label, "", "end");
   doc.close_group();
   doc.text({left + area_.w / 2.0, bottom + 36.0}, x_label, attr("class", "label x-label"), "middle");
   doc.text({left - 52.0, top + area_.h / 2.0}, y_label, attr("class", "label y-label"), "middle", -90.0);

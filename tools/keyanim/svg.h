@@ -79,6 +79,14 @@ class Axes {
   // marks, tick labels and the axis labels (class "label"; put the unit in the label).
   void draw(Document& doc, const std::string& x_label, const std::string& y_label, int x_ticks = 8,
             int y_ticks = 6) const;
+  // The same with the ticks given: where (in data units) and what they say, e.g. a log axis
+  // drawn over log10 of its values with the values as labels.
+  struct Tick {
+    double at;
+    std::string label;
+  };
+  void draw(Document& doc, const std::string& x_label, const std::string& y_label, const std::vector<Tick>& x_ticks,
+            const std::vector<Tick>& y_ticks) const;
 
  private:
   Rect area_;
