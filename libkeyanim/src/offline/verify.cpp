@@ -29,24 +29,13 @@ bool same_curve_kind(const EncodedChannel& a, const EncodedChannel& b) {
 
 }  // namespace
 
-double ChannelCursor::at(uint32_t f) {
+void ChannelCursor::prepare() {
   const EncodedChannel& ch = *ch_;
-  const size_t n = ch.frames.size();
-  if (n == 0) return 0.0;
-  const uint32_t* k = ch.frames.data();
-  if (n == 1 || f <= k[0]) return dequantize(ch.q[0], ch.step);
-  if (f >= k[n - 1]) return dequantize(ch.q[n - 1], ch.step);
-  if (j_ == SIZE_MAX) j_ = size_t(std::upper_bound(k, k + n, f) - k) - 1;  // k[0] < f < k[n-1]
-  while (k[j_ + 1] <= f) ++j_;
-  if (f == k[j_]) return dequantize(ch.q[j_], ch.step);
-  if (prepared_ != j_) {
-    const size_t j = j_;
-    const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
-    ops_ = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
-                            ch.interp, tension_to_s(ch.tension), rule_);
-    prepared_ = j;
-  }
-  return eval_operands(ops_, segment_u(k[j_], k[j_ + 1], float(f)));
+  const size_t j = j_, n = ch.frames.size();
+  const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
+  ops_ = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
+                          ch.interp, tension_to_s(ch.tension), rule_);
+  prepared_ = j;
 }
 
 void decode_channel_at(const EncodedChannel& ch, TangentRule rule, const uint32_t* frames, size_t count, double* out,

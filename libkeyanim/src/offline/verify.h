@@ -20,8 +20,21 @@ class ChannelCursor {
  public:
   ChannelCursor() = default;
   ChannelCursor(const EncodedChannel& ch, TangentRule rule) : ch_(&ch), rule_(rule) {}
-  // The value at frame f; f must not decrease from call to call.
-  double at(uint32_t f);
+  // The value at frame f; f must not decrease from call to call. (Inline: verification calls
+  // it for every channel of every node it poses.)
+  double at(uint32_t f) {
+    const EncodedChannel& ch = *ch_;
+    const size_t n = ch.frames.size();
+    if (n == 0) return 0.0;
+    const uint32_t* k = ch.frames.data();
+    if (n == 1 || f <= k[0]) return dequantize(ch.q[0], ch.step);
+    if (f >= k[n - 1]) return dequantize(ch.q[n - 1], ch.step);
+    if (j_ == SIZE_MAX) j_ = size_t(std::upper_bound(k, k + n, f) - k) - 1;  // k[0] < f < k[n-1]
+    while (k[j_ + 1] <= f) ++j_;
+    if (f == k[j_]) return dequantize(ch.q[j_], ch.step);
+    if (prepared_ != j_) prepare();
+    return eval_operands(ops_, segment_u(k[j_], k[j_ + 1], float(f)));
+  }
 
  private:
   const EncodedChannel* ch_ = nullptr;
@@ -29,6 +42,7 @@ class ChannelCursor {
   size_t j_ = SIZE_MAX;         // segment [k[j], k[j+1]) of the last frame; SIZE_MAX: none yet
   size_t prepared_ = SIZE_MAX;  // segment whose operands are in ops_
   SegmentOperands ops_;
+  void prepare();  // ops_ of segment j_
 };
 
 // The values of channel `ch` at the sorted frames `frames[0..count)`, into out[i * stride].
