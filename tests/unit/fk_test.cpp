@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -222,6 +223,59 @@ TEST_CASE("fk sine and cosine are within one ulp of libm, exact at right angles"
     CHECK(s == (q == 1 ? 1.0 : q == 3 ? -1.0 : 0.0));
     CHECK(c == (q == 0 ? 1.0 : q == 2 ? -1.0 : 0.0));
   }
+}
+
+TEST_CASE("fk of two frames at once is bit for bit two frames one at a time") {
+  // Every corpus frame paired with another, with and without a node subset, plus angles that
+  // take the scalar path (10^9 degrees and more) in one lane only.
+  std::vector<Motion> motions;
+  for (const auto& path : keyanim::test::corpus_bvh_files()) {  // (skipped without the corpus)
+    if (path.filename().string().find("131_03") == std::string::npos &&
+        path.filename().string().find("05_20-daz") == std::string::npos)
+      continue;
+    Motion m;
+    keyanim::offline::BvhError err;
+    REQUIRE(keyanim::offline::read_bvh_file(path.string(), m, err));
+    motions.push_back(std::move(m));
+  }
+  Motion odd;
+  odd.skeleton = skeleton_of({joint("Hips", -1, {1, 2, 3}, {kXp, kZr, kXr, kYr}), joint("Arm", 0, {0, 4, 0}, {kZr, kXr, kYr}),
+                              end_site(1, {0, 0, 5})});
+  odd.frame_count = 3;
+  odd.values = {0.5, 30.25, -1e9, 720.5, 45, 135, -225,
+                -2, 3e12, -17.5, 90, -45, -135, 1e-300,
+                0, -0.0, 44.999999999999, 45.000000000001, -90, 180, 359.5};
+  motions.push_back(odd);
+  size_t differ = 0, pairs = 0;
+  std::vector<Vec3> a, b, a2, b2;
+  for (const Motion& m : motions) {
+    const size_t n = m.skeleton.joints.size();
+    std::vector<uint8_t> some(n, 0);
+    for (size_t j = 0; j < n; j += 3) some[j] = 1;  // every third node and its ancestors
+    for (size_t j = n; j-- > 0;)
+      if (some[j] && m.skeleton.joints[j].parent >= 0) some[size_t(m.skeleton.joints[j].parent)] = 1;
+    for (uint32_t f = 0; f < m.frame_count; ++f) {
+      const uint32_t g = (f * 7 + 3) % m.frame_count;
+      for (const uint8_t* nodes : {static_cast<const uint8_t*>(nullptr), static_cast<const uint8_t*>(some.data())}) {
+        keyanim::offline::world_positions(m.skeleton, m.frame(f), m.frame(g), nodes, a2, b2);
+        if (nodes) {
+          keyanim::offline::world_positions(m.skeleton, m.frame(f), nodes, a);
+          keyanim::offline::world_positions(m.skeleton, m.frame(g), nodes, b);
+        } else {
+          keyanim::offline::world_positions(m.skeleton, m.frame(f), a);
+          keyanim::offline::world_positions(m.skeleton, m.frame(g), b);
+        }
+        for (size_t j = 0; j < n; ++j) {
+          if (nodes && !nodes[j]) continue;
+          for (int k = 0; k < 3; ++k)
+            differ += std::memcmp(&a[j][k], &a2[j][k], 8) != 0 || std::memcmp(&b[j][k], &b2[j][k], 8) != 0;
+        }
+        ++pairs;
+      }
+    }
+  }
+  CHECK(pairs > 1000);
+  CHECK(differ == 0);
 }
 
 TEST_CASE("fk local rotation equals the product of literal elementary matrices") {

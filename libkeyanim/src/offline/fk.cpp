@@ -2,10 +2,15 @@
 #include "keyanim/offline/fk.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace keyanim::offline {
 namespace {
@@ -22,22 +27,54 @@ constexpr Mat3 kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 // Developed at SunPro, a Sun Microsystems, Inc. business.
 // Permission to use, copy, modify, and distribute this software is freely granted, provided
 // that this notice is preserved.
-inline void kernel_sin_cos(double x, double& s, double& c) noexcept {
+template <class D>  // double, or Lanes2 below: the same operations on each lane
+inline void kernel_sin_cos(D x, D& s, D& c) noexcept {
   constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
                    S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
                    S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
   constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
                    C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
                    C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-  const double z = x * x;
-  const double w = z * z;
-  const double rs = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
-  s = x + z * x * (S1 + z * rs);
-  const double rc = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
-  const double hz = 0.5 * z;
-  const double one_minus = 1.0 - hz;
-  c = one_minus + (((1.0 - one_minus) - hz) + z * rc);
+  const D z = x * x;
+  const D w = z * z;
+  const D rs = D(S2) + z * (D(S3) + z * D(S4)) + z * w * (D(S5) + z * D(S6));
+  s = x + z * x * (D(S1) + z * rs);
+  const D rc = z * (D(C1) + z * (D(C2) + z * D(C3))) + w * w * (D(C4) + z * (D(C5) + z * D(C6)));
+  const D hz = D(0.5) * z;
+  const D one_minus = D(1.0) - hz;
+  c = one_minus + (((D(1.0) - one_minus) - hz) + z * rc);
 }
+
+// Two doubles at once (two frames posed together): SSE2 where there is SSE2 (every x86-64),
+// else two plain doubles. Each lane goes through exactly the operations of a double.
+#if defined(__SSE2__)
+struct Lanes2 {
+  __m128d v;
+  Lanes2() = default;
+  explicit Lanes2(__m128d x) : v(x) {}
+  explicit Lanes2(double x) : v(_mm_set1_pd(x)) {}
+  Lanes2(double a, double b) : v(_mm_set_pd(b, a)) {}
+  double lane(int i) const {
+    alignas(16) double out[2];
+    _mm_store_pd(out, v);
+    return out[i];
+  }
+};
+inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return Lanes2(_mm_add_pd(a.v, b.v)); }
+inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return Lanes2(_mm_sub_pd(a.v, b.v)); }
+inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return Lanes2(_mm_mul_pd(a.v, b.v)); }
+#else
+struct Lanes2 {
+  double x[2];
+  Lanes2() = default;
+  explicit Lanes2(double v) : x{v, v} {}
+  Lanes2(double a, double b) : x{a, b} {}
+  double lane(int i) const { return x[i]; }
+};
+inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.x[0] + b.x[0], a.x[1] + b.x[1]}; }
+inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.x[0] - b.x[0], a.x[1] - b.x[1]}; }
+inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.x[0] * b.x[0], a.x[1] * b.x[1]}; }
+#endif
 
 }  // namespace
 
@@ -68,21 +105,62 @@ void sin_cos_deg(double deg, double& s, double& c) noexcept {
 
 namespace {
 
+// sin_cos_deg of both lanes, bit for bit. Angles of 10^9 degrees or more (or NaN) take the
+// scalar path: below that the quadrant fits a 32-bit integer.
+inline void sin_cos_deg2(Lanes2 deg, Lanes2& s, Lanes2& c) noexcept {
+#if defined(__SSE2__)
+  const __m128d magnitude = _mm_andnot_pd(_mm_set1_pd(-0.0), deg.v);
+  if (_mm_movemask_pd(_mm_cmplt_pd(magnitude, _mm_set1_pd(1e9))) != 3) {
+    double s0, c0, s1, c1;
+    sin_cos_deg(deg.lane(0), s0, c0);
+    sin_cos_deg(deg.lane(1), s1, c1);
+    s = Lanes2(s0, s1), c = Lanes2(c0, c1);
+    return;
+  }
+  const __m128d scaled = _mm_mul_pd(deg.v, _mm_set1_pd(1.0 / 90.0));
+  const __m128d ge = _mm_cmpge_pd(scaled, _mm_setzero_pd());
+  const __m128d half = _mm_or_pd(_mm_and_pd(ge, _mm_set1_pd(0.5)), _mm_andnot_pd(ge, _mm_set1_pd(-0.5)));
+  const __m128i q = _mm_cvttpd_epi32(_mm_add_pd(scaled, half));  // two int32, as the scalar int64
+  const Lanes2 r((_mm_mul_pd(_mm_sub_pd(deg.v, _mm_mul_pd(_mm_cvtepi32_pd(q), _mm_set1_pd(90.0))),
+                            _mm_set1_pd(kRadPerDeg))));
+  Lanes2 sr, cr;
+  kernel_sin_cos(r, sr, cr);
+  // Per lane: swap for odd quadrants, negate s for quadrants 2 and 3, c for 1 and 2.
+  const __m128i q64 = _mm_shuffle_epi32(q, _MM_SHUFFLE(1, 1, 0, 0));
+  const __m128i one = _mm_set1_epi32(1), two = _mm_set1_epi32(2);
+  const __m128d swap = _mm_castsi128_pd(_mm_cmpeq_epi32(_mm_and_si128(q64, one), one));
+  const __m128d sign = _mm_set1_pd(-0.0);
+  const __m128d neg_s = _mm_and_pd(_mm_castsi128_pd(_mm_cmpeq_epi32(_mm_and_si128(q64, two), two)), sign);
+  const __m128d neg_c =
+      _mm_and_pd(_mm_castsi128_pd(_mm_cmpeq_epi32(_mm_and_si128(_mm_add_epi32(q64, one), two), two)), sign);
+  s = Lanes2(_mm_xor_pd(_mm_or_pd(_mm_and_pd(swap, cr.v), _mm_andnot_pd(swap, sr.v)), neg_s));
+  c = Lanes2(_mm_xor_pd(_mm_or_pd(_mm_and_pd(swap, sr.v), _mm_andnot_pd(swap, cr.v)), neg_c));
+#else
+  sin_cos_deg(deg.x[0], s.x[0], c.x[0]);
+  sin_cos_deg(deg.x[1], s.x[1], c.x[1]);
+#endif
+}
+
+}  // namespace
+
+namespace {
+
 // m = m * R_axis(angle). Only the two columns other than `axis` change:
 // col_a' = c*col_a + s*col_b, col_b' = c*col_b - s*col_a with (a, b) = (axis+1, axis+2) mod 3.
 // One instance per axis, so that the indices are constants (FK is most of the encoder's time).
-template <int Axis>
-inline void post_rotate_axis(Mat3& m, double s, double c) noexcept {
+template <int Axis, class D>
+inline void post_rotate_axis(std::array<D, 9>& m, D s, D c) noexcept {
   constexpr int a = (Axis + 1) % 3;
   constexpr int b = (Axis + 2) % 3;
   for (int r = 0; r < 3; ++r) {
-    const double ma = m[r * 3 + a];
-    const double mb = m[r * 3 + b];
+    const D ma = m[r * 3 + a];
+    const D mb = m[r * 3 + b];
     m[r * 3 + a] = c * ma + s * mb;
     m[r * 3 + b] = c * mb - s * ma;
   }
 }
-inline void post_rotate(Mat3& m, int axis, double s, double c) noexcept {
+template <class D>
+inline void post_rotate(std::array<D, 9>& m, int axis, D s, D c) noexcept {
   switch (axis) {
     case 0: return post_rotate_axis<0>(m, s, c);
     case 1: return post_rotate_axis<1>(m, s, c);
@@ -94,47 +172,62 @@ inline bool is_root(const Joint& joint, size_t index) noexcept {
   return joint.parent < 0 || static_cast<size_t>(joint.parent) >= index;
 }
 
-struct ComputeSinCos {
-  void operator()(uint32_t /*column*/, double deg, double& s, double& c) const noexcept { sin_cos_deg(deg, s, c); }
+// Where pose_frame gets a channel's value and the sine and cosine of a rotation's.
+struct OneRow {
+  using D = double;
+  const double* row;
+  D value(uint32_t column) const noexcept { return row[column]; }
+  void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg(row[column], s, c); }
 };
 struct GivenSinCos {
+  using D = double;
+  const double* row;
   const double* sines;
   const double* cosines;
-  void operator()(uint32_t column, double /*deg*/, double& s, double& c) const noexcept {
-    s = sines[column], c = cosines[column];
-  }
+  D value(uint32_t column) const noexcept { return row[column]; }
+  void sin_cos(uint32_t column, D& s, D& c) const noexcept { s = sines[column], c = cosines[column]; }
+};
+struct TwoRows {
+  using D = Lanes2;
+  const double* a;
+  const double* b;
+  D value(uint32_t column) const noexcept { return {a[column], b[column]}; }
+  void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg2(value(column), s, c); }
 };
 
-// The one FK loop everything else uses. pos and rot have room for every node. With `nodes`,
-// only the nodes it marks (a set holding every ancestor of its members) are computed.
-template <typename SinCos>
-void pose_frame(const Skeleton& skeleton, const double* row, Vec3* pos, Mat3* rot, SinCos sin_cos,
+// The one FK loop everything else uses, on one frame (double) or two (Lanes2). pos and rot have
+// room for every node. With `nodes`, only the nodes it marks (a set holding every ancestor of
+// its members) are computed.
+template <typename Values, typename D = typename Values::D>
+void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
                 const uint8_t* nodes = nullptr) noexcept {
+  const D zero(0.0), one(1.0);
+  const std::array<D, 9> identity{one, zero, zero, zero, one, zero, zero, zero, one};
   const size_t n = skeleton.joints.size();
   for (size_t j = 0; j < n; ++j) {
     if (nodes && !nodes[j]) continue;
     const Joint& joint = skeleton.joints[j];
     const bool root = is_root(joint, j);
-    const Mat3& parent_rot = root ? kIdentity : rot[joint.parent];
-    Vec3 t = joint.offset;
-    Mat3& r = rot[j];
+    const std::array<D, 9>& parent_rot = root ? identity : rot[joint.parent];
+    std::array<D, 3> t{D(joint.offset[0]), D(joint.offset[1]), D(joint.offset[2])};
+    std::array<D, 9>& r = rot[j];
     r = parent_rot;
-    const double* v = row + joint.first_channel;
     for (size_t k = 0; k < joint.channels.size(); ++k) {
       const ChannelType type = joint.channels[k];
+      const uint32_t column = joint.first_channel + uint32_t(k);
       if (is_rotation(type)) {
-        double sn, cs;
-        sin_cos(joint.first_channel + uint32_t(k), v[k], sn, cs);
+        D sn, cs;
+        values.sin_cos(column, sn, cs);
         post_rotate(r, channel_axis(type), sn, cs);
       } else {
-        t[static_cast<size_t>(channel_axis(type))] = v[k];
+        t[static_cast<size_t>(channel_axis(type))] = values.value(column);
       }
     }
     if (root) {
       pos[j] = t;
     } else {
-      const Vec3& pp = pos[joint.parent];
-      const Mat3& m = parent_rot;
+      const std::array<D, 3>& pp = pos[joint.parent];
+      const std::array<D, 9>& m = parent_rot;
       pos[j] = {pp[0] + m[0] * t[0] + m[1] * t[1] + m[2] * t[2],
                 pp[1] + m[3] * t[0] + m[4] * t[1] + m[5] * t[2],
                 pp[2] + m[6] * t[0] + m[7] * t[1] + m[8] * t[2]};
@@ -161,29 +254,43 @@ namespace {
 
 // World positions into `out`, with a per-thread rotation scratch so that the encoder's
 // per-frame calls allocate nothing after the first.
-template <typename SinCos>
-void positions_with_scratch(const Skeleton& skeleton, const double* frame_row, SinCos sin_cos,
-                            std::vector<Vec3>& out, const uint8_t* nodes = nullptr) {
+template <typename Values>
+void positions_with_scratch(const Skeleton& skeleton, const Values& values, std::vector<Vec3>& out,
+                            const uint8_t* nodes = nullptr) {
   thread_local std::vector<Mat3> rotations;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n);
   out.resize(n);
-  pose_frame(skeleton, frame_row, out.data(), rotations.data(), sin_cos, nodes);
+  pose_frame(skeleton, values, out.data(), rotations.data(), nodes);
 }
 
 }  // namespace
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, frame_row, ComputeSinCos{}, out);
+  positions_with_scratch(skeleton, OneRow{frame_row}, out);
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, frame_row, ComputeSinCos{}, out, nodes);
+  positions_with_scratch(skeleton, OneRow{frame_row}, out, nodes);
+}
+
+void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b) {
+  thread_local std::vector<std::array<Lanes2, 9>> rotations;
+  thread_local std::vector<std::array<Lanes2, 3>> positions;
+  const size_t n = skeleton.joints.size();
+  if (rotations.size() < n) rotations.resize(n), positions.resize(n);
+  out_a.resize(n), out_b.resize(n);
+  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes);
+  for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
+    for (int a = 0; a < 3; ++a) out_a[j][a] = positions[j][a].lane(0), out_b[j][a] = positions[j][a].lane(1);
+  }
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,
                      std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, frame_row, GivenSinCos{sines, cosines}, out);
+  positions_with_scratch(skeleton, GivenSinCos{frame_row, sines, cosines}, out);
 }
 
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
@@ -191,7 +298,7 @@ void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<V
   const size_t n = skeleton.joints.size();
   positions.resize(n);
   rotations.resize(n);
-  pose_frame(skeleton, frame_row, positions.data(), rotations.data(), ComputeSinCos{});
+  pose_frame(skeleton, OneRow{frame_row}, positions.data(), rotations.data());
 }
 
 std::vector<Vec3> world_positions_all(const Motion& motion) {
@@ -206,8 +313,7 @@ std::vector<Vec3> world_positions_all(const Motion& motion) {
   std::vector<Vec3> out(frames * n, Vec3{kNaN, kNaN, kNaN});
   std::vector<Mat3> rotations(n);
   for (size_t f = 0; f < complete; ++f) {
-    pose_frame(motion.skeleton, motion.values.data() + f * channels, out.data() + f * n,
-               rotations.data(), ComputeSinCos{});
+    pose_frame(motion.skeleton, OneRow{motion.values.data() + f * channels}, out.data() + f * n, rotations.data());
   }
   return out;
 }

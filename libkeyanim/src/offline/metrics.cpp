@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "keyanim/offline/fk.h"
@@ -52,19 +53,42 @@ void measured_points(const Skeleton& skeleton, const double* frame_row, std::vec
   else world_positions(skeleton, frame_row, points);
 }
 
+void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b,
+                     std::vector<std::array<double, 3>>& points_a, std::vector<std::array<double, 3>>& points_b,
+                     const uint8_t* nodes) {
+  world_positions(skeleton, row_a, row_b, nodes, points_a, points_b);
+}
+
 uint32_t measure_window(uint32_t frame_count) {
   const uint32_t windows_of_min = (frame_count + kWindow - 1) / kWindow;
   return kWindow * std::max<uint32_t>(1, (windows_of_min + kMaxWindows - 1) / kMaxWindows);
 }
 
+// Whether FK poses two skeletons alike (then one skeleton serves both, two rows at a time).
+bool same_pose_rules(const Skeleton& a, const Skeleton& b) {
+  if (&a == &b) return true;
+  if (a.joints.size() != b.joints.size()) return false;
+  for (size_t j = 0; j < a.joints.size(); ++j) {
+    const Joint &x = a.joints[j], &y = b.joints[j];
+    if (x.parent != y.parent || x.channels != y.channels || x.first_channel != y.first_channel ||
+        std::memcmp(x.offset.data(), y.offset.data(), sizeof x.offset) != 0)
+      return false;
+  }
+  return true;
+}
+
 ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, const Skeleton* decoded)
     : skeleton_(&skeleton),
-      decoded_skeleton_(decoded ? decoded : &skeleton),
+      decoded_skeleton_(decoded && !same_pose_rules(skeleton, *decoded) ? decoded : &skeleton),
       joint_max_(skeleton.joints.size(), 0.0), channel_max_(skeleton.channel_count(), 0.0) {}
 
 void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const double* decoded) {
-  measured_points(*skeleton_, original, a_);
-  measured_points(*decoded_skeleton_, decoded, b_);
+  if (decoded_skeleton_ == skeleton_) {
+    measured_points(*skeleton_, original, decoded, a_, b_);
+  } else {
+    measured_points(*skeleton_, original, a_);
+    measured_points(*decoded_skeleton_, decoded, b_);
+  }
   const size_t nodes = joint_max_.size();
   for (size_t j = 0; j < nodes; ++j) {
     double e = 0.0;

@@ -128,8 +128,7 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
         w.row[c] = w.cursors[c].at(f);
       }
     }
-    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.original, w.pose.data());
-    measured_points(m.skeleton, w.row.data(), w.decoded, w.pose.data());
+    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.row.data(), w.original, w.decoded, w.pose.data());
     bool frame_over = false;
     for (size_t d = 0; d < nodes; ++d) {
       if (!w.measure[d]) continue;
@@ -156,7 +155,8 @@ ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, unsigned th
   const uint32_t frames = m.frame_count, n_ch = m.channel_count();
   const uint32_t window = measure_window(frames);
   const size_t windows = (size_t(frames) + window - 1) / window;
-  std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton, &enc.skeleton));
+  // The clip's skeleton is the motion's (encode copies it): one skeleton poses both.
+  std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton));
   parallel_for(windows, threads, [&](size_t w, unsigned) {
     Cursor cursor;
     if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
@@ -169,7 +169,7 @@ ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, unsigned th
       parts[w].add_frame(f, m.values.data() + size_t(f) * n_ch, decoded.data());
     }
   });
-  ErrorAccumulator total(m.skeleton, &enc.skeleton);
+  ErrorAccumulator total(m.skeleton);
   for (const ErrorAccumulator& p : parts) total.merge(p);
   return total.report(frames);
 }

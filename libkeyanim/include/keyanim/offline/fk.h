@@ -41,6 +41,10 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, std::vec
 // its members (positions of the other nodes are left as they were): for callers that know
 // which nodes moved.
 void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out);
+// Two frames at once (two lanes of SIMD where the machine has them), bit for bit what two
+// calls of the above give; `nodes` may be null (every node).
+void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values

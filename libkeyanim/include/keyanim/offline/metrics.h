@@ -32,6 +32,11 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded);
 constexpr uint32_t kPointsPerNode = 1;
 void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points,
                      const uint8_t* nodes = nullptr);
+// The same for two frame rows at once (bit for bit two calls; faster): an original frame and
+// its decoding, say.
+void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b,
+                     std::vector<std::array<double, 3>>& points_a, std::vector<std::array<double, 3>>& points_b,
+                     const uint8_t* nodes = nullptr);
 
 // measure_error in pieces, for callers that produce the decoded frames themselves (window by
 // window, on several threads): add frames to one accumulator per window, merge the windows in
