@@ -10,6 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/curvature.h"
@@ -47,6 +50,15 @@ double tighten_margin(uint32_t round) {
 constexpr uint32_t kMaxRounds = 50;
 // Frames per verification job: small enough that a job's decoded rows stay in cache.
 constexpr uint32_t kVerifyWindow = 128;
+
+// Freed memory goes back to the system: glibc keeps the scattered pages of many small vectors
+// (each channel's keys, reallocated every round), and the phases after the rounds would add
+// their peak on top (memory is a target: bench_codec's peak_rss_over_bvh_bytes).
+void release_free_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
 
 ChannelFitOptions fit_options(const EncodeSettings& s) {
   ChannelFitOptions o;
@@ -194,6 +206,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     return false;
   const uint32_t rounds = fit_within_tolerance(job, size, error);
   if (rounds == 0) return false;
+  release_free_memory();  // the rounds' budgets and fits, before the measurement takes its own
 
   // A clip the container cannot store (a frame time of 0 with several frames, a value whose
   // quantized integer overflows in the fixed-key modes) is an error, not a result.
@@ -207,6 +220,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   out.total_keys = 0;
   for (const EncodedChannel& ch : enc.channels) out.total_keys += ch.frames.size();
   enc.notes = encoder_notes(settings, tol_units, out.error, out.iterations);
+  release_free_memory();  // the measurement's clip, before the caller writes the file
   return true;
 }
 
