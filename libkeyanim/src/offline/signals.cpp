@@ -60,8 +60,7 @@ ChannelLayout channel_layout(const Skeleton& s) {
 void channel_signal(const Motion& m, const ChannelLayout& layout, uint32_t c, std::vector<double>& out) {
   const size_t stride = layout.node.size();  // not m.channel_count(): that walks the skeleton
   out.resize(m.frame_count);
-  const double* v = m.values.data() + c;
-  for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = v[size_t(f) * stride];
+  for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = m.values[size_t(f) * stride + c];
   if (layout.rotation[c]) unwrap_degrees(out);
 }
 
