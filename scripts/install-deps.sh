@@ -7,8 +7,9 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
   g++ cmake make pkg-config libzstd-dev zlib1g-dev nlohmann-json3-dev doctest-dev python3 >/dev/null
-# GNU parallel: the batch-conversion test (tests/cli/manifest_test.sh) runs the README's recipe.
-$SUDO apt-get install -y -qq --no-install-recommends parallel >/dev/null
+# GNU parallel: the batch-conversion test (tests/cli/manifest_test.sh) runs the README's recipe
+# (and kills it midway: ps lists the processes).
+$SUDO apt-get install -y -qq --no-install-recommends parallel procps >/dev/null
 # For scripts/sanitize.sh's fuzz step: clang with libFuzzer (optional; skipped if unavailable).
 $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null 2>&1 ||
   $SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >/dev/null 2>&1 ||

@@ -4,7 +4,7 @@
 # basics:   mirrored outputs, shards that add up to the list, the report, --skip-existing,
 #           failures, usage errors;
 # parallel: GNU parallel (-S 2/:, one shard per job) over 200 generated clips, killed midway
-#           (SIGKILL to the whole process group), resumed with --joblog --resume-failed;
+#           (SIGKILL to every process of the run), resumed with --joblog --resume-failed;
 # slurm:    scripts/slurm_encode.sh run for every SLURM_ARRAY_TASK_ID of an array, then again.
 # After parallel and slurm: every output loads and verifies against its input, and the report
 # lists each input exactly once.
@@ -107,12 +107,18 @@ parallel)
     [ "$(cat ../report.jsonl 2>/dev/null | wc -l)" -ge 60 ] && break
     sleep 0.05
   done
-  kill -KILL -- -"$pid" 2>/dev/null
+  # A crash: every process of the run stops at once, wherever it is. GNU parallel gives each
+  # job its own process group, so the tree is collected by parent id (stopped first, so that
+  # nothing new starts meanwhile) and killed by process id.
+  tree() { local c; for c in $(ps -o pid= --ppid "$1"); do echo "$c"; tree "$c"; done; }
+  all="$pid"
+  for _ in 1 2 3; do all="$all $(tree "$pid")"; kill -STOP $all 2>/dev/null; done
+  kill -KILL $all 2>/dev/null
   wait "$pid" 2>/dev/null
   done_jobs=$(($(wc -l <../jobs.log) - 1))
   [ "$done_jobs" -lt "$N" ] || die "parallel finished all $N shards before it could be killed"
   echo "killed after $done_jobs of $N shards, $(wc -l <../report.jsonl) inputs reported"
-  run --resume-failed >/dev/null 2>&1 || die "the resumed run failed"
+  run --resume-failed >resume.log 2>&1 || { tail -20 resume.log >&2; die "the resumed run failed"; }
   [ "$(($(wc -l <../jobs.log) - 1))" = "$N" ] || die "the joblog does not hold every shard after resuming"
   cd ..
   check_done out report.jsonl
