@@ -101,6 +101,24 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
     w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
 }
 
+// The arrays were grown by push_back: give back what they reserved beyond their size (up to
+// half of each), since a loaded clip lives long.
+void shrink(Image& img) {
+  img.skeleton.joints.shrink_to_fit();
+  for (Joint& j : img.skeleton.joints) j.name.shrink_to_fit(), j.channels.shrink_to_fit();
+  img.node_offset.shrink_to_fit();
+  img.pose_steps.shrink_to_fit();
+  img.pose_first.shrink_to_fit();
+  img.fixed_channels.shrink_to_fit();
+  img.curves.shrink_to_fit();
+  img.list_frames.shrink_to_fit();
+  img.list_values.shrink_to_fit();
+  for (auto* v : {&img.curve_s, &img.first_frame, &img.last_frame, &img.first_value, &img.last_value})
+    v->shrink_to_fit();
+  img.curve_linear.shrink_to_fit();
+  img.notes.shrink_to_fit();
+}
+
 }  // namespace
 
 size_t Image::memory_bytes() const noexcept {
@@ -245,6 +263,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
                    cv.q_base, cv.base_bits);
     }
   }
+  shrink(*img);
   return img;
 }
 
