@@ -162,15 +162,18 @@ inline int32_t unzigzag32(uint64_t u) noexcept {
   c[3] += static_cast<int32_t>(kBlockFrames);
 }
 
+// Bits 0..t set: the frames of a block at or before block_start + t.
+inline uint64_t frames_upto(uint32_t t) noexcept { return t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1; }
+
+// `upto` is frames_upto(t) (the same for every curve of a pose: computed once).
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint32_t t, Window& w) noexcept {
+[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint64_t upto, Window& w) noexcept {
   uint64_t mask;
   std::memcpy(&mask, rec, 8);
   const uint32_t vw = rec[8], kw = rec[9];
   // Keys up to t (bits 0..t) and after it; k_j, k_{j-1} are the highest keys at or below t,
   // k_{j+1}, k_{j+2} the lowest above, else the context keys before or after the block (read
   // only then: in a dense channel two keys on each side are the usual case).
-  const uint64_t upto = t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1;
   const uint64_t below = mask & upto;
   const uint64_t above = mask & ~upto;
   const uint32_t count = popcount64<kPopcnt>(below);

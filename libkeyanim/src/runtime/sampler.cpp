@@ -78,18 +78,19 @@ struct BlockView {
   const uint8_t* payload;
   const uint32_t* offsets;  // the block's row of record offsets
   const Curve* curves;
+  uint64_t upto;            // frames_upto(t): the block's keys at or before the position
 };
 
 BlockView block_view(const Image& img, const Position& at) noexcept {
-  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_curves, img.curves.data()};
+  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_curves, img.curves.data(),
+          frames_upto(at.t)};
 }
 
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t curve, uint32_t t, Batch& b,
-                                          uint32_t i) noexcept {
+[[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t curve, Batch& b, uint32_t i) noexcept {
   const Curve& cv = v.curves[curve];
   Window w;
-  read_window<kPopcnt>(v.payload + v.offsets[curve], cv.base_bits, t, w);
+  read_window<kPopcnt>(v.payload + v.offsets[curve], cv.base_bits, v.upto, w);
   std::memcpy(b.frames[i], w.frame, sizeof w.frame);
   dequantize4(w, cv, b.values[i]);
 }
@@ -220,7 +221,7 @@ template <bool kPopcnt>
         continue;
       }
       if (curve < img.block_curves)
-        gather<kPopcnt>(view, curve, at.t, b, i);
+        gather<kPopcnt>(view, curve, b, i);
       else
         gather_list(img, curve, at, b, i);
       copy_facts(img, curve, b, i);
@@ -238,7 +239,7 @@ template <bool kPopcnt>
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
-    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, at.t, b, i);
+    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, b, i);
     for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
   };
   auto facts = [&](const Batch&, uint32_t base) {
@@ -312,7 +313,7 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
   const Position at = position(img, f);
   const uint8_t* rec = img.record(at.block, curve);
   Window w;
-  read_window<false>(rec, cv.base_bits, at.t, w);
+  read_window<false>(rec, cv.base_bits, frames_upto(at.t), w);
   float v[4];
   dequantize4(w, cv, v);
   const int32_t start = static_cast<int32_t>(at.block << kBlockShift);
@@ -324,7 +325,7 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
   int32_t c[4];
   read_context(rec, kw, c);
   s.after[0] = c[2] + start, s.after[1] = c[3] + start;
-  const uint64_t upto = at.t >= 63 ? ~uint64_t(0) : (uint64_t(2) << at.t) - 1;
+  const uint64_t upto = frames_upto(at.t);
   const uint64_t above = mask & ~upto;
   const uint64_t above_rest = above & (above - 1);
   s.rest = above_rest & (above_rest - 1);
