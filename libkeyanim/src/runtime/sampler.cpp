@@ -16,6 +16,7 @@ namespace keyanim::internal {
 namespace {
 
 constexpr uint32_t kChunk = 32;  // a multiple of 4 (SIMD lanes)
+constexpr uint32_t kPrefetchAhead = 6;  // curves
 
 // Pass one's output for a chunk: per lane its keys j-1 .. j+2 (frames relative to the block,
 // dequantized values), and the per-curve facts the evaluation needs (which the sampler of all
@@ -239,7 +240,13 @@ template <bool kPopcnt>
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
-    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, b, i);
+    for (uint32_t i = 0; i < blocked; ++i) {
+      // The record a few curves ahead: its address needs a load first, so a cold clip's misses
+      // overlap only if they are asked for early.
+      if (base + i + kPrefetchAhead < img.block_curves)
+        __builtin_prefetch(view.payload + view.offsets[base + i + kPrefetchAhead]);
+      gather<kPopcnt>(view, base + i, b, i);
+    }
     for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
   };
   auto facts = [&](const Batch&, uint32_t base) {
