@@ -18,8 +18,9 @@ namespace keyanim::cli {
 const char* const kExitCodeTable =
     "exit codes:\n"
     "  0  success\n"
-    "  1  usage: unknown option, bad or out-of-range value, conflicting options (e.g. --json\n"
-    "     with -o -), a frame, joint or channel the input does not have\n"
+    "  1  usage: no command, an unknown command or option, a bad or out-of-range value,\n"
+    "     conflicting options (e.g. --json with -o -), a frame, joint or channel the input\n"
+    "     does not have\n"
     "  2  input unreadable or malformed, or without what the command needs (no frames)\n"
     "  3  input uses an unsupported format version or feature\n"
     "  4  output cannot be written: exists (without -f), is an input, would also be another\n"

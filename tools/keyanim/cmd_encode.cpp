@@ -18,8 +18,8 @@
 namespace keyanim::cli {
 
 const char* const kEncodeHelp =
-    "usage: keyanim encode IN.bvh [-o OUT.kanim] [--error E|E%] [--keys MODE] [--tension T|fit]\n"
-    "                      [--level N] [--json] [-f]\n"
+    "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--keys MODE]\n"
+    "                      [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode).\n"
     "  -o, --output FILE     output (default: IN with .kanim; '-' = standard output).\n"
     "                        IN may be a directory: every .bvh below it is encoded to the same\n"

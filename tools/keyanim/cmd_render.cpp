@@ -17,7 +17,7 @@ namespace keyanim::cli {
 
 const char* const kRenderHelp =
     "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg]\n"
-    "                      [--error E|E%] [--keys MODE] [--tension T|fit] [-f]\n"
+    "                      [--error E|E%] [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
     "file length units. Two poses are overlaid and the joint farthest apart is labelled:\n"
     "  - with --against OTHER (BVH or .kanim with the same skeleton): IN and OTHER;\n"

@@ -19,6 +19,7 @@ const char* const kVerifyHelp =
     "Loads and validates every byte of IN (signature, version, sections, checksum). With\n"
     "--against, decodes it and measures the world-space error of every joint and End Site\n"
     "against ORIG by forward kinematics; the hierarchy, frame count and frame time must match.\n"
+    "  --against ORIG.bvh    the original to measure the decoded clip against\n"
     "  --max-error E|E%      fail (exit 5) if the error exceeds E file units, or E percent of\n"
     "                        the skeleton size (default: no limit, just report)\n"
     "  --json                one JSON object on standard output\n"

@@ -1,5 +1,6 @@
 // keyanim: command-line front end. Dispatches to one subcommand; global options may appear
 // anywhere before "--".
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -19,28 +20,28 @@ struct Command {
   const char* name;
   int (*run)(const Argv&, Globals&);
   const char* const* help;
-  bool encoder_options;
+  enum { none, all, all_but_error } encoder_options;  // the shared ones of settings.h
   const char* summary;
 };
 
 const Command kCommands[] = {
-    {"encode", cmd_encode, &kEncodeHelp, true, "BVH -> .kanim (keyframes within a tolerance)"},
-    {"decode", cmd_decode, &kDecodeHelp, false, ".kanim -> BVH, at the source or another frame rate"},
-    {"info", cmd_info, &kInfoHelp, false, "describe a BVH or .kanim file"},
-    {"sample", cmd_sample, &kSampleHelp, false, "one pose of a .kanim at a frame or time"},
-    {"plot", cmd_plot, &kPlotHelp, true, "SVG: one channel, original against reconstruction, keys marked"},
-    {"render", cmd_render, &kRenderHelp, true, "SVG: one frame as a stick figure, front and side view"},
-    {"eval", cmd_eval, &kEvalHelp, true, "compression against error for files and tolerances"},
-    {"verify", cmd_verify, &kVerifyHelp, false, "check a .kanim, and its error against the original"},
-    {"view", cmd_view, &kViewHelp, false, "HTML page that plays a .kanim in the browser (3D skeleton)"},
+    {"encode", cmd_encode, &kEncodeHelp, Command::all, "BVH -> .kanim (keyframes within a tolerance)"},
+    {"decode", cmd_decode, &kDecodeHelp, Command::none, ".kanim -> BVH, at the source or another frame rate"},
+    {"info", cmd_info, &kInfoHelp, Command::none, "describe a BVH or .kanim file"},
+    {"sample", cmd_sample, &kSampleHelp, Command::none, "one pose of a .kanim at a frame or time"},
+    {"plot", cmd_plot, &kPlotHelp, Command::all, "SVG: one channel, original against reconstruction, keys marked"},
+    {"render", cmd_render, &kRenderHelp, Command::all, "SVG: one frame as a stick figure, front and side view"},
+    {"eval", cmd_eval, &kEvalHelp, Command::all_but_error, "compression against error for files and tolerances"},
+    {"verify", cmd_verify, &kVerifyHelp, Command::none, "check a .kanim, and its error against the original"},
+    {"view", cmd_view, &kViewHelp, Command::none, "HTML page that plays a .kanim in the browser (3D skeleton)"},
 };
 
 const char* const kGlobalHelp =
-    "global options:\n"
+    "global options (before or after the command; short ones combine, e.g. -qV or -fq):\n"
     "  -h, --help            this help (after a command: that command's help)\n"
     "  -V, --version         tool and format versions (-qV: the bare version)\n"
     "  -v, --verbose         more messages on standard error\n"
-    "  -q, --quiet           no messages but errors\n"
+    "  -q, --quiet           no messages but errors, no progress\n"
     "  -f, --force           overwrite existing outputs (never an input); allow binary output\n"
     "                        to a terminal\n"
     "  --max-input SIZE      largest input file read, in bytes (K, M, G: powers of 1024);\n"
@@ -48,11 +49,45 @@ const char* const kGlobalHelp =
     "  --max-values N        most values (frames x channels) a decode may make, and most keys\n"
     "                        a loaded .kanim may hold; default 256M\n";
 
+// The usage lines and the list of commands: the start of --help, and all a bare `keyanim` says.
+void print_usage(std::ostream& out) {
+  out << "Usage: keyanim [GLOBAL OPTIONS] COMMAND [OPTIONS] INPUT [-o OUTPUT]\n"
+         "  or:  keyanim help [COMMAND]\n"
+         "keyanim " KEYANIM_VERSION_STRING ": skeletal motion stored as keyframes only, every other frame\n"
+         "rebuilt by Cardinal-spline interpolation.\n\ncommands:\n";
+  char line[160];
+  for (const Command& c : kCommands) {
+    std::snprintf(line, sizeof line, "  %-8s %s\n", c.name, c.summary);
+    out << line;
+  }
+  out << "  help     this help, or a command's: keyanim help COMMAND (= keyanim COMMAND --help)\n";
+}
+
 void print_main_help() {
-  std::cout << "keyanim " KEYANIM_VERSION_STRING " - skeletal motion as keyframes, rebuilt by Cardinal splines\n"
-               "usage: keyanim COMMAND [options] INPUT [-o OUTPUT]\n\ncommands:\n";
-  for (const Command& c : kCommands) std::printf("  %-8s %s\n", c.name, c.summary);
-  std::cout << "\n" << kGlobalHelp << "\n" << kExitCodeTable << "\nRun 'keyanim COMMAND --help' for a command's options.\n";
+  print_usage(std::cout);
+  std::cout << "\n" << kGlobalHelp << "\n" << kExitCodeTable << "\nRun 'keyanim help COMMAND' for a command's options.\n";
+}
+
+const Command* find_command(const std::string& name) {
+  for (const Command& c : kCommands)
+    if (name == c.name) return &c;
+  return nullptr;
+}
+
+void print_command_help(const Command& c) {
+  std::cout << *c.help;
+  if (c.encoder_options != Command::none) std::cout << encoder_options_help(c.encoder_options == Command::all);
+  std::cout << "\n" << kGlobalHelp << "\n" << kExitCodeTable;
+}
+
+// `keyanim help [COMMAND]`.
+int help_command(const Argv& rest) {
+  if (rest.empty()) return print_main_help(), kOk;
+  if (rest.size() > 1) fail(kUsage, "help takes at most one command");
+  const Command* c = find_command(rest.front());
+  if (!c) fail(kUsage, "unknown command '" + rest.front() + "'");
+  print_command_help(*c);
+  return kOk;
 }
 
 // The value of global option `name` at argv[i] ("--name V" or "--name=V"), advancing i past it.
@@ -61,6 +96,22 @@ std::optional<std::string> global_value(const std::string& a, const std::string&
   if (a != name) return std::nullopt;
   if (i + 1 >= argc) fail(kUsage, "option " + name + " needs a value");
   return std::string(argv[++i]);
+}
+
+// A global short flag, or a cluster of them ("-qV", "-fq"), applied left to right as if given
+// one by one. False if `a` is not made of global flags only (it may be a command's option).
+bool global_flags(const std::string& a, Globals& g, bool& help, bool& version) {
+  if (a.size() < 2 || a[0] != '-' || a.find_first_not_of("hVvqf", 1) != std::string::npos) return false;
+  for (size_t k = 1; k < a.size(); ++k) {
+    switch (a[k]) {
+      case 'h': help = true; break;
+      case 'V': version = true; break;
+      case 'v': ++g.verbosity; break;
+      case 'q': g.verbosity = 0; break;
+      default: g.force = true; break;
+    }
+  }
+  return true;
 }
 
 int run(int argc, char** argv) {
@@ -72,12 +123,12 @@ int run(int argc, char** argv) {
     const std::string a = argv[i];
     if (!options_done && a == "--") options_done = true;
     if (options_done) { rest.push_back(a); continue; }
-    if (a == "-h" || a == "--help") help = true;
-    else if (a == "-V" || a == "--version") version = true;
-    else if (a == "-v" || a == "--verbose") ++g.verbosity;
-    else if (a == "-q" || a == "--quiet") g.verbosity = 0;
-    else if (a == "-f" || a == "--force") g.force = true;
-    else if (a == "-qV" || a == "-Vq") version = true, g.verbosity = 0;
+    if (global_flags(a, g, help, version)) continue;
+    if (a == "--help") help = true;
+    else if (a == "--version") version = true;
+    else if (a == "--verbose") ++g.verbosity;
+    else if (a == "--quiet") g.verbosity = 0;
+    else if (a == "--force") g.force = true;
     else if (auto in = global_value(a, "--max-input", argc, argv, i)) g.limits.max_input_bytes = parse_size("--max-input", *in);
     else if (auto n = global_value(a, "--max-values", argc, argv, i)) g.limits.max_values = parse_size("--max-values", *n);
     else rest.push_back(a);
@@ -89,21 +140,17 @@ int run(int argc, char** argv) {
   }
   if (rest.empty()) {
     if (help) { print_main_help(); return kOk; }
-    std::cerr << "keyanim: missing command\nTry 'keyanim --help'.\n";
+    print_usage(std::cerr);  // like git and zstd: what there is to type
+    std::cerr << "\nkeyanim: missing command. Run 'keyanim help' for the global options and exit codes.\n";
     return kUsage;
   }
   const std::string name = rest.front();
   rest.erase(rest.begin());
-  for (const Command& c : kCommands) {
-    if (name != c.name) continue;
-    if (help) {
-      std::cout << *c.help << (c.encoder_options ? kEncodeOptionsHelp : "") << "\n" << kGlobalHelp << "\n" << kExitCodeTable;
-      return kOk;
-    }
-    return c.run(rest, g);
-  }
-  std::cerr << "keyanim: unknown command '" << printable(name) << "'\nTry 'keyanim --help'.\n";
-  return kUsage;
+  if (name == "help") return help_command(help ? Argv{} : rest);
+  const Command* c = find_command(name);
+  if (!c) fail(kUsage, "unknown command '" + name + "'");
+  if (help) return print_command_help(*c), kOk;
+  return c->run(rest, g);
 }
 
 }  // namespace

@@ -4,18 +4,22 @@
 
 namespace keyanim::cli {
 
-const char* const kEncodeOptionsHelp =
-    "  --error E|E%          tolerance: max world-space joint error, in file length units, or in\n"
-    "                        percent of the skeleton size (largest side of the rest-pose box).\n"
-    "                        Default 0.05%. Range: > 0 (percent: at most 100).\n"
-    "  --keys MODE           error (default): fewest keys within --error;\n"
-    "                        uniform:N every N-th frame (N >= 1); manual:F1,F2,... those frames;\n"
-    "                        curvature: curvature feature points. First and last frame always.\n"
-    "                        Only error mode applies --error as a tolerance; the others report\n"
-    "                        the error reached (and warn when it exceeds a given --error).\n"
-    "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
-    "                        least squares per channel, kept where it saves keys.\n"
-    "  --level N             zstd level, 1..22. Default 19.\n";
+std::string encoder_options_help(bool with_error) {
+  const char* const error =
+      "  --error E|E%          tolerance: max world-space joint error, in file length units, or in\n"
+      "                        percent of the skeleton size (largest side of the rest-pose box).\n"
+      "                        Default 0.05%. Range: > 0 (percent: at most 100).\n";
+  const char* const others =
+      "  --keys MODE           error (default): fewest keys within --error;\n"
+      "                        uniform:N every N-th frame (N >= 1); manual:F1,F2,... those frames;\n"
+      "                        curvature: curvature feature points. First and last frame always.\n"
+      "                        Only error mode applies --error as a tolerance; the others report\n"
+      "                        the error reached (and warn when it exceeds a given --error).\n"
+      "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
+      "                        least squares per channel, kept where it saves keys.\n"
+      "  --level N             zstd level, 1..22. Default 19.\n";
+  return std::string(with_error ? error : "") + others;
+}
 
 void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
   std::string t = text;

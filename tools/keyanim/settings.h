@@ -24,7 +24,8 @@ void parse_key_mode(const std::string& text, offline::EncodeSettings& s);
 // --keys manual frame past its last frame. Checked before encoding.
 void check_settings_for(const offline::EncodeSettings& s, const offline::Motion& motion, const std::string& path);
 
-// The help lines for these options (defaults and ranges).
-extern const char* const kEncodeOptionsHelp;
+// The help lines for these options (defaults and ranges); without --error for a command that
+// describes its own (eval takes a list).
+std::string encoder_options_help(bool with_error);
 
 }  // namespace keyanim::cli
