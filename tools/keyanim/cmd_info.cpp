@@ -1,7 +1,9 @@
 // keyanim info: what a BVH or .kanim file holds.
 #include <algorithm>
+#include <cstdio>
 #include <iostream>
 #include <set>
+#include <sstream>
 
 #include "commands.h"
 #include "escape.h"
@@ -40,10 +42,33 @@ nlohmann::json skeleton_json(const Skeleton& s) {
           {"rotation_orders", std::vector<std::string>(orders.begin(), orders.end())}};
 }
 
+std::string number(double v, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*g", digits, v);
+  return text;
+}
+
+// The encoder's notes as an indented block, a line each (none for an empty line).
+void print_notes(const std::string& notes) {
+  std::cout << "encoder_notes:" << (notes.find_first_not_of('\n') == std::string::npos ? " (none)" : "") << "\n";
+  std::istringstream lines(notes);
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty()) std::cout << "  " << printable(line) << "\n";
+}
+
 // Names and notes come from the file: printable() keeps their bytes from acting on a terminal.
+// Quantities with a unit say it.
 void print_text(const nlohmann::json& j) {
   for (auto it = j.begin(); it != j.end(); ++it) {
-    if (it->is_object()) {
+    if (it.key() == "encoder_notes") {
+      print_notes(it->get<std::string>());
+    } else if (it.key() == "size") {
+      std::cout << "size: " << number(it->get<double>(), 4)
+                << " units (the file's length units; largest side of the rest pose's bounding box)\n";
+    } else if (it.key() == "frame_time") {
+      const double t = it->get<double>();
+      std::cout << "frame_time: " << json_text(*it) << " s" << (t > 0 ? " (" + number(1.0 / t, 6) + " fps)" : "") << "\n";
+    } else if (it->is_object()) {
       std::cout << it.key() << ":\n";
       for (auto sub = it->begin(); sub != it->end(); ++sub)
         std::cout << "  " << sub.key() << ": " << printable(json_text(*sub)) << "\n";
