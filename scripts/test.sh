@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
-# The whole test suite: build, then every test through CTest. Corpus tests use ../shared/corpus
-# when it exists beside the checkout and are skipped (with a message) otherwise. Then the same
-# suite under ASan + UBSan and a short run of every fuzz target (scripts/sanitize.sh; set
-# KEYANIM_SKIP_SANITIZE=1 to leave that out locally).
+# The whole test suite: build (warnings are errors: scripts/configure.sh), then every test through
+# CTest. Corpus tests use ../shared/corpus when it exists beside the checkout and are reported as
+# skipped, with the reason, otherwise. Then the same suite under ASan + UBSan, built with clang
+# (whose warnings are errors too), and a short run of every fuzz target (scripts/sanitize.sh;
+# KEYANIM_SKIP_SANITIZE=1 leaves that out: the quick variant).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+start=$SECONDS
+scripts/configure.sh build -DCMAKE_BUILD_TYPE=Release -DKEYANIM_BUILD_TESTS=ON -DKEYANIM_BUILD_BENCH=ON
 cmake --build build -j"$(nproc)"
 ctest --test-dir build -j"$(nproc)" --output-on-failure
 if [ ! -d ../shared/corpus ]; then
   echo "keyanim: ../shared/corpus not found beside the checkout: the corpus tests listed as Skipped above did not run"
 fi
+echo "keyanim: build and tests took $((SECONDS - start)) s"
 if [ "${KEYANIM_SKIP_SANITIZE:-0}" != 1 ]; then
   scripts/sanitize.sh
+  echo "keyanim: scripts/test.sh took $((SECONDS - start)) s in all"
 fi

@@ -26,7 +26,7 @@ TEST_CASE("zstd output bound covers the content of real frames") {
   for (size_t size : {size_t(0), size_t(1), size_t(1000), size_t(131072), size_t(131073), size_t(1) << 20}) {
     std::vector<uint8_t> zeros(size, 0), noise(size), text(size);
     for (auto& b : noise) b = uint8_t(rng());
-    for (size_t i = 0; i < size; ++i) text[i] = "JOINT Hips OFFSET 0.0 {\n"[i % 24] ^ uint8_t((i / 4096) & 1);
+    for (size_t i = 0; i < size; ++i) text[i] = uint8_t("JOINT Hips OFFSET 0.0 {\n"[i % 24] ^ ((i / 4096) & 1));
     for (const auto* data : {&zeros, &noise, &text}) {
       for (int level : {1, 19}) {
         CAPTURE(size);
