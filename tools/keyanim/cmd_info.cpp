@@ -15,7 +15,7 @@
 namespace keyanim::cli {
 
 const char* const kInfoHelp =
-    "usage: keyanim info FILE [--json]\n"
+    "usage: keyanim info IN.bvh|IN.kanim [--json]\n"
     "Describes a BVH or .kanim file (recognised by its first bytes): skeleton, frames, frame time,\n"
     "channels, skeleton size; for .kanim also version, keys per channel, tensions and encoder notes.\n"
     "  --json                one JSON object on standard output\n";
