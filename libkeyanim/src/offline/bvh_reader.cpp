@@ -455,7 +455,12 @@ bool Parser::parse_frames(Motion& m, uint64_t declared, const Token& declared_to
     values.resize(size_t(std::min(declared, bound)) * channels);
   }
 
+  const char* const first = p_;
+  auto progress = [&] {
+    if (options_.progress) options_.progress(end_ == first ? 1.0 : double(p_ - first) / double(end_ - first));
+  };
   while (p_ != end_) {
+    if (lines % 1024 == 0) progress();
     skip_blanks();
     if (p_ == end_) break;
     if (is_eol(*p_)) {  // blank line
@@ -505,6 +510,7 @@ bool Parser::parse_frames(Motion& m, uint64_t declared, const Token& declared_to
     n += channels;
     ++lines;
   }
+  progress();
 
   if (channels == 0) {
     lines = declared;  // no value can confirm or deny the count; nothing is allocated for it

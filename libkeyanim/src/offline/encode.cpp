@@ -9,6 +9,7 @@
 #include "keyanim/offline/encode.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -60,6 +61,11 @@ void release_free_memory() {
 #endif
 }
 
+// settings.progress, if any, with `done` of `total`.
+void report(const EncodeSettings& s, EncodeStage stage, size_t done, size_t total) {
+  if (s.progress) s.progress(stage, total ? double(done) / double(total) : 1.0);
+}
+
 ChannelFitOptions fit_options(const EncodeSettings& s) {
   ChannelFitOptions o;
   o.rule = s.tangent_rule;
@@ -94,6 +100,7 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
   };
   std::vector<Worker> workers(parallel_workers(refit.size(), job.threads));
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> ranges(refit.size());
+  std::atomic<size_t> done{0};  // counted by every worker, reported by worker 0 (the caller's thread)
   // Channels are fitted independently: the result does not depend on the threads.
   parallel_for(refit.size(), job.threads, [&](size_t i, unsigned w) {
     const uint32_t c = refit[i];
@@ -114,7 +121,10 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
     }
     if (round > 0) changed_ranges(job.enc.channels[c], fitted, m.frame_count, ranges[i]);
     job.enc.channels[c] = std::move(fitted);
+    const size_t d = ++done;
+    if (w == 0) report(job.settings, EncodeStage::fitting, d, refit.size());
   });
+  report(job.settings, EncodeStage::fitting, 1, 1);
   for (size_t i = 0; i < refit.size(); ++i)
     for (const auto& [a, b] : ranges[i]) marks.mark(job.layout.node[refit[i]], a, b);
 }
@@ -125,11 +135,15 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
   const size_t windows = (size_t(frames) + kVerifyWindow - 1) / kVerifyWindow;
   std::vector<std::vector<OverNode>> over(windows);
   std::vector<VerifyScratch> scratch(parallel_workers(windows, job.threads));
+  std::atomic<size_t> done{0};  // as in fit_channels
   parallel_for(windows, job.threads, [&](size_t w, unsigned t) {
     const uint32_t first = uint32_t(w * kVerifyWindow);
     verify_window(job.m, job.enc.channels, job.enc.tangent_rule, job.tol_units, first,
                   std::min(kVerifyWindow, frames - first), marks, over[w], scratch[t]);
+    const size_t d = ++done;
+    if (t == 0) report(job.settings, EncodeStage::verifying, d, windows);
   });
+  report(job.settings, EncodeStage::verifying, 1, 1);
   marks.clear_moved();
   // Each channel that moves an over-budget node is tightened at that frame by the largest
   // ratio any of its nodes needs, frame after frame.
@@ -214,7 +228,9 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     error = "cannot be stored: " + why;
     return false;
   }
+  report(settings, EncodeStage::measuring, 0, 1);
   out.error = measure_encoded(m, enc, threads);
+  report(settings, EncodeStage::measuring, 1, 1);
   out.tolerance_units = tol_units;
   out.iterations = rounds;
   out.total_keys = 0;

@@ -24,6 +24,9 @@ struct BvhError {
 struct BvhReadOptions {
   uint32_t max_joints = 1u << 16;  // Defaults to 65536 nodes; more is an error, not an allocation.
   uint32_t max_frames = 1u << 24;  // Defaults to 16777216 frames.
+  // Defaults to none. Called every 1024 motion lines with the fraction of the motion text read
+  // (0 to 1), and once at its end: a progress display for long files.
+  std::function<void(double fraction)> progress;
 };
 
 // Parses BVH text. On success fills `out` and appends any warnings (e.g. more motion lines than

@@ -2,6 +2,7 @@
 // default mode) guarantee a maximum world-space joint error for what a decoder will produce.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,13 @@ enum class KeyMode : uint8_t {
   curvature = 3,  // curvature feature points (curvature.h)
 };
 
+// What encode() is doing, for a progress display.
+enum class EncodeStage : uint8_t {
+  fitting = 0,    // choosing keys and fitting the curves, channel by channel
+  verifying = 1,  // error mode: every joint of the decoded frames against the original
+  measuring = 2,  // the error report, on exactly what a decoder reproduces
+};
+
 struct EncodeSettings {
   KeyMode key_mode = KeyMode::error;       // Defaults to error-bounded.
   double tolerance = 0.05;                 // Defaults to 0.05 (percent of the skeleton size).
@@ -31,6 +39,12 @@ struct EncodeSettings {
   bool force_linear = false;               // Defaults to false. True: every channel linear (comparisons).
   int zstd_level = 19;                     // Defaults to 19 (1..22).
   uint32_t threads = 1;                    // Defaults to 1; 0: one per core. Output is the same.
+  // Defaults to none. Called as encode() works: the stage and the fraction of it done, 0 to 1.
+  // Error mode runs fitting and verifying in rounds until every joint is within the tolerance,
+  // each round's stages counting from 0 again. Called on the thread that called encode(), never
+  // concurrently, at most once per channel or frame: keep it cheap. The result does not depend
+  // on it.
+  std::function<void(EncodeStage stage, double fraction)> progress;
 
   // Empty if valid, else what is wrong.
   std::string validate() const;
