@@ -1,6 +1,5 @@
 #include "batch.h"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -12,6 +11,7 @@
 #include <thread>
 
 #include "escape.h"
+#include "progress.h"
 
 namespace keyanim::cli {
 
@@ -49,18 +49,24 @@ unsigned thread_count(const Args& args) {
 int run_batch(size_t count, unsigned threads, const Globals& g, const std::function<void(size_t)>& job,
               const std::vector<std::string>& names) {
   std::vector<int> codes(count, kOk);
-  std::atomic<size_t> next{0}, done{0};
+  std::atomic<size_t> next{0};
   std::mutex out_mutex;
-  const bool bar = g.verbosity > 0 && count > 1 && isatty(STDERR_FILENO);
+  // The bar counts bytes of input done, so that its time left holds with files of all sizes.
+  Globals shown = g;
+  if (count < 2) shown.verbosity = 0;
+  Progress bar(shown, std::to_string(count) + " inputs");
+  std::vector<uint64_t> sizes(count, 1);
+  uint64_t total = 0, done_bytes = 0;
+  size_t done = 0;
+  for (size_t i = 0; i < count && bar.shown(); ++i) {
+    std::error_code ec;
+    sizes[i] = std::max<uint64_t>(1, std::filesystem::file_size(names[i], ec));
+  }
+  for (uint64_t s : sizes) total += s;
   auto progress = [&] {  // caller holds out_mutex
-    if (!bar) return;
-    const size_t d = done.load();
-    const int width = 30, filled = int(double(d) / double(count) * width);
-    std::fprintf(stderr, "\r[%s%s] %zu/%zu", std::string(size_t(filled), '#').c_str(),
-                 std::string(size_t(width - filled), ' ').c_str(), d, count);
-    if (d == count) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
+    bar.update(std::to_string(done) + " done", double(done_bytes) / double(total));
   };
+  progress();
   auto worker = [&] {
     for (size_t i; (i = next.fetch_add(1)) < count;) {
       std::string message;
@@ -74,10 +80,10 @@ int run_batch(size_t count, unsigned threads, const Globals& g, const std::funct
         codes[i] = f.code;
         message = names[i] + ": " + f.message;
       }
-      ++done;
       std::lock_guard<std::mutex> lock(out_mutex);
+      ++done, done_bytes += sizes[i];
       if (!message.empty()) {
-        if (bar) std::fprintf(stderr, "\r%*s\r", 50, "");
+        bar.erase();
         std::cerr << "keyanim: " << printable(message) << "\n";
       }
       progress();
@@ -92,6 +98,7 @@ int run_batch(size_t count, unsigned threads, const Globals& g, const std::funct
   }
   worker();
   for (std::thread& t : pool) t.join();
+  bar.erase();
   size_t failed = 0;
   int first = kOk;
   for (int c : codes)

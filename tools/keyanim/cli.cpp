@@ -12,6 +12,7 @@
 
 #include "escape.h"
 #include "keyanim/offline/bvh.h"
+#include "progress.h"
 
 namespace keyanim::cli {
 
@@ -136,13 +137,17 @@ bool looks_like_kanim(const std::vector<uint8_t>& b) {
   return b.size() >= 4 && b[0] == 0x89 && b[1] == 'K' && b[2] == 'A' && b[3] == 'N';
 }
 
-offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g) {
+offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g,
+                               EncodeProgress* progress) {
   if (looks_like_kanim(bytes)) fail(kBadInput, path + ": is a .kanim file, expected BVH text");
   offline::Motion m;
   offline::BvhError err;
   std::vector<std::string> warnings;
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  if (!offline::read_bvh(text, path, m, err, &warnings)) fail(kBadInput, err.to_string());
+  offline::BvhReadOptions options;
+  if (progress) options.progress = progress->parsing();
+  if (!offline::read_bvh(text, path, m, err, &warnings, options)) fail(kBadInput, err.to_string());
+  if (progress && !warnings.empty()) progress->erase();
   if (g.verbosity > 0)
     for (const std::string& w : warnings) std::cerr << "keyanim: warning: " << printable(w) << "\n";
   return m;

@@ -14,6 +14,8 @@
 
 namespace keyanim::cli {
 
+class EncodeProgress;
+
 // Exit codes: one per kind of error, documented by kExitCodeTable (--help) and the README;
 // scripts depend on them.
 enum Exit : int {
@@ -84,7 +86,9 @@ void check_values(uint64_t frames, uint64_t channels, const std::string& what, c
 
 bool looks_like_kanim(const std::vector<uint8_t>& bytes);
 // BVH text -> motion, or exit 2 naming file:line:column. Warnings go to stderr unless quiet.
-offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);
+// With `progress`, parsing shows on its bar (progress.h).
+offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g,
+                               EncodeProgress* progress = nullptr);
 // .kanim bytes -> clip, or exit 2 (3 for an unsupported version, 6 over the loader's limits or
 // more keys than --max-values) naming section and offset.
 Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);

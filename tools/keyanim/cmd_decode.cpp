@@ -5,6 +5,7 @@
 #include "escape.h"
 #include "gltf_output.h"
 #include "io.h"
+#include "progress.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/decode.h"
 
@@ -69,12 +70,15 @@ int cmd_decode(const Argv& argv, Globals& g) {
   offline::BvhWriter writer(clip.skeleton(), decoder.frame_count(), decoder.frame_time(),
                             [&](std::string_view text) { output.write(text); });
   std::vector<double> row(clip.channel_count());
+  Progress bar(g, in);
   for (uint64_t i = 0; i < decoder.frame_count(); ++i) {
+    if (i % 256 == 0) bar.update("decoding", double(i) / double(decoder.frame_count()));
     decoder.frame(i, row);
     writer.frame(row.data());
   }
   if (!writer.finish()) fail(kInternal, "decode wrote a frame count other than the one it declared");
   output.commit();
+  bar.erase();
   if (g.verbosity > 0 && out != "-")
     std::cerr << printable(in + " -> " + out) << ": " << decoder.frame_count() << " frames at " << decoder.frame_time() << " s\n";
   return kOk;

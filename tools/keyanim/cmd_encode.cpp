@@ -12,6 +12,7 @@
 #include "encode_one.h"
 #include "io.h"
 #include "manifest.h"
+#include "progress.h"
 #include "report.h"
 #include "settings.h"
 
@@ -41,24 +42,27 @@ const char* const kEncodeHelp =
 
 // Encodes one file. Every check that needs no work comes first (input, output, options against
 // the input); the output is written only when everything else has succeeded. Memory: the BVH
-// text goes once parsed, the motion's values once encoded.
-Encoded encode_one(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
-                   bool error_given, const Globals& g) {
+// text goes once parsed, the motion's values once encoded. With `bar`, the stages show on it.
+Encoded encode_one(const std::string& in, const std::string& out, offline::EncodeSettings settings,
+                   bool error_given, const Globals& g, Progress* bar) {
   Input input(in, g);
   Output output(out, true, g, ids_of({&input}));
+  EncodeProgress progress(bar, settings.key_mode == offline::KeyMode::error);
   offline::Motion motion;
   size_t bvh_size = 0;
   {
     const std::vector<uint8_t> bvh_bytes = input.read(Kind::bvh);
     bvh_size = bvh_bytes.size();
-    motion = load_bvh_bytes(in, bvh_bytes, g);
+    motion = load_bvh_bytes(in, bvh_bytes, g, &progress);
   }
   check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
   offline::EncodeResult result;
   std::string error;
+  settings.progress = progress.encoding();
   if (!offline::encode(motion, settings, result, error)) fail(kBadInput, in + ": " + error);
   std::vector<double>().swap(motion.values);
+  progress.compressing();
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
   if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -168,7 +172,9 @@ int cmd_encode(const Argv& argv, Globals& g) {
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".kanim");
   if (json && out == "-") fail(kUsage, "--json and the .kanim would both go to standard output: give -o FILE");
   settings.threads = thread_count(args);  // one file: its channels in parallel
-  const Encoded e = encode_one(in, out, settings, args.has("--error"), g);
+  Progress bar(g, in);
+  const Encoded e = encode_one(in, out, settings, args.has("--error"), g, &bar);
+  bar.erase();
   if (json) std::cout << json_text(e.summary) << "\n";
   else if (g.verbosity > 0) std::cerr << human_line(e.summary) << "\n";
   print_warning(e, g);

@@ -14,9 +14,12 @@ struct Encoded {
   std::string warning;     // --error exceeded in a key mode that does not apply it
 };
 
+class Progress;
+
 // Checks the input and the output first (io.h), then encodes, writes atomically and returns
-// the summary printed by --json; fails (cli::Failure) otherwise.
-Encoded encode_one(const std::string& in, const std::string& out, const offline::EncodeSettings& settings,
-                   bool error_given, const Globals& g);
+// the summary printed by --json; fails (cli::Failure) otherwise. With `bar`, its stages show on
+// it (progress.h).
+Encoded encode_one(const std::string& in, const std::string& out, offline::EncodeSettings settings,
+                   bool error_given, const Globals& g, Progress* bar = nullptr);
 
 }  // namespace keyanim::cli
