@@ -9,7 +9,8 @@ cd "$(dirname "$0")/.."
 start=$SECONDS
 scripts/configure.sh build -DCMAKE_BUILD_TYPE=Release -DKEYANIM_BUILD_TESTS=ON -DKEYANIM_BUILD_BENCH=ON
 cmake --build build -j"$(nproc)"
-ctest --test-dir build -j"$(nproc)" --output-on-failure
+# build/ctest-results.xml: each test's status and output (JUnit), for scripts/newcomer.sh.
+ctest --test-dir build -j"$(nproc)" --output-on-failure --output-junit ctest-results.xml
 if [ ! -d ../shared/corpus ]; then
   echo "keyanim: ../shared/corpus not found beside the checkout: the corpus tests listed as Skipped above did not run"
 fi

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# A new user's first minutes, as a script (issue 16). CI runs it after scripts/test.sh (.ci/run).
+# It builds twice from scratch (the set-up's build, then the test suite's), a few minutes on two
+# cores, so it is a CI step rather than a CTest test that every local run would pay for. Locally:
+# scripts/newcomer.sh (it clones the committed HEAD: commit first).
+#  1. a fresh clone of this repository in a scratch directory, with no ../shared beside it;
+#  2. the README's set-up command (the ```sh block under "Quick start"), as written, installing
+#     into a scratch prefix (KEYANIM_PREFIX: an installed keyanim is left alone), with that
+#     prefix's bin/ on PATH as the set-up asks;
+#  3. every session of the README (blocks of "$ " lines) pasted line by line, printing what the
+#     README shows (tests/newcomer/readme_session.py);
+#  4. every command's --help read for options described twice and incomplete usage lines
+#     (tests/cli/help_test.py); `man keyanim` and the bash completion found;
+#  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
+#     as skipped with their reason, and no test may pass without checking anything
+#     (tests/newcomer/ctest_report.py).
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=python3
+T=$(mktemp -d "${TMPDIR:-/tmp}/keyanim-newcomer.XXXXXX")
+trap 'rm -rf "$T"' EXIT
+step() { printf '\nnewcomer: %s\n' "$*"; }
+# block HEADING PATTERN: the first ```sh block after the README heading, that holds PATTERN.
+block() { awk -v h="$1" -v p="$2" '$0 ~ "^## " h {s=1} s && /^```sh/ {b=1; t=""; next}
+                                    b && /^```/ {if (t ~ p) {printf "%s", t; exit} b=0; next} b {t = t $0 "\n"}' README.md; }
+
+step "1. a fresh clone of $(git -C "$here" rev-parse --short HEAD), with no ../shared beside it"
+[ -z "$(git -C "$here" status --porcelain --untracked-files=no)" ] ||
+  echo "newcomer: note: uncommitted changes in $here are not in the clone"
+git clone -q "$here" "$T/keyanim"
+[ ! -e "$T/shared" ] || { echo "newcomer: FAIL: $T/shared exists"; exit 1; }
+cd "$T/keyanim"
+
+step "2. the README's set-up command"
+setup=$(block "Quick start" "quickstart")
+[ -n "$setup" ] || { echo "newcomer: FAIL: no set-up command under the README's Quick start"; exit 1; }
+printf '%s\n' "$setup"
+export KEYANIM_PREFIX=$T/prefix
+bash -euo pipefail -c "$setup"
+export PATH="$KEYANIM_PREFIX/bin:$PATH"
+[ "$(command -v keyanim)" = "$KEYANIM_PREFIX/bin/keyanim" ] || { echo "newcomer: FAIL: keyanim is not installed"; exit 1; }
+
+step "3. the README's sessions, pasted line by line"
+"$PY" tests/newcomer/readme_session.py README.md
+
+step "4. every command's help; man keyanim; bash completion"
+"$PY" tests/cli/help_test.py "$(command -v keyanim)"
+man -w keyanim | grep -q "^$KEYANIM_PREFIX/" || { echo "newcomer: FAIL: man keyanim does not find the installed page"; exit 1; }
+[ -f "$KEYANIM_PREFIX/share/bash-completion/completions/keyanim" ] || { echo "newcomer: FAIL: no bash completion installed"; exit 1; }
+echo "man page and completion installed"
+
+step "5. the README's test command, without the sanitizer stage"
+tests=$(block "Running the tests" "scripts/test.sh")
+[ -n "$tests" ] || { echo "newcomer: FAIL: no test command in the README"; exit 1; }
+printf '%s\n' "$tests"
+KEYANIM_SKIP_SANITIZE=1 KEYANIM_PROPERTY_SECONDS=10 bash -euo pipefail -c "$tests" 2>&1 | tee "$T/test.log"
+grep -q "corpus not found beside the checkout: the corpus tests listed as Skipped above did not run" "$T/test.log" ||
+  { echo "newcomer: FAIL: the test command does not say why tests were skipped"; exit 1; }
+"$PY" tests/newcomer/ctest_report.py build/ctest-results.xml --expect-skips
+step "ok"

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""The README's sessions, pasted line by line: readme_session.py README.md
+
+Runs, in the current directory and in order, every command of every session block of the README
+(a fenced block whose lines start with "$ ": the command, then what it prints), with bash, as a
+user pasting them would. Where the README shows output, what the command prints (standard output
+and error together) must be the same, compared word by word per line, except the timing columns
+of a table whose header ends in "enc ms  dec ms". Exits 1 on the first command that fails or
+prints something else, showing both.
+"""
+import re
+import subprocess
+import sys
+
+TIMING_HEADER = re.compile(r"enc ms\s+dec ms\s*$")
+
+
+def parse(readme):
+    """[(command, [lines the README shows it print])] of every session block (a fenced block whose
+    first line starts with '$ '), in order."""
+    result = []
+    in_block, is_session, first = False, False, False
+    for line in open(readme, encoding="utf-8").read().splitlines():
+        if line.startswith("```"):
+            in_block, is_session, first = not in_block, False, True
+            continue
+        if not in_block:
+            continue
+        if first:
+            is_session, first = line.startswith("$ "), False
+        if not is_session:
+            continue
+        if line.startswith("$ "):
+            result.append((line[2:], []))
+        else:
+            result[-1][1].append(line)
+    return result
+
+
+def words(line, timing, header):
+    w = line.split()
+    if timing:
+        w = w[:-4] if header else w[:-2]
+    return w
+
+
+def same(expected, actual):
+    if len(expected) != len(actual):
+        return False
+    timing = False
+    for e, a in zip(expected, actual):
+        header = bool(TIMING_HEADER.search(e))
+        timing = timing or header
+        if words(e, timing, header) != words(a, timing, header):
+            return False
+    return True
+
+
+def main():
+    commands = parse(sys.argv[1])
+    if not commands:
+        print("FAIL: no session in", sys.argv[1])
+        return 1
+    for command, expected in commands:
+        p = subprocess.run(["bash", "-c", command], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           text=True, timeout=600)
+        actual = p.stdout.rstrip("\n").split("\n") if p.stdout.strip() else []
+        print("$", command)
+        print(p.stdout, end="")
+        if p.returncode != 0:
+            print(f"FAIL: exit {p.returncode}")
+            return 1
+        if expected and not same(expected, actual):
+            print("FAIL: the README shows:")
+            print("\n".join(expected))
+            return 1
+    print(f"readme session: {len(commands)} commands as the README shows them")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
