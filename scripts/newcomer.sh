@@ -20,6 +20,8 @@ PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 T=$(mktemp -d "${TMPDIR:-/tmp}/keyanim-newcomer.XXXXXX")
 trap 'rm -rf "$T"' EXIT
+export TMPDIR=$T/tmp  # what the commands leave in the temporary directory (keyanim view's page) goes too
+mkdir "$TMPDIR"
 step() { printf '\nnewcomer: %s\n' "$*"; }
 # block HEADING PATTERN: the first ```sh block after the README heading, that holds PATTERN.
 block() { awk -v h="$1" -v p="$2" '$0 ~ "^## " h {s=1} s && /^```sh/ {b=1; t=""; next}
