@@ -111,6 +111,9 @@ def main():
         code, out, err = run([keyanim, "decode", k, "-o", os.path.join(tmp, "back.bvh")])
         check(code == 0 and "walk.kanim: decoding  [" in err and err.rsplit("\r", 1)[-1].startswith(CSI_ERASE),
               f"decode under a terminal: exit {code}, {err[-300:]!r}")
+        code, out, err = run([keyanim, "decode", k, "-o", os.path.join(tmp, "walk.glb")])
+        check(code == 0 and "walk.kanim: fitting, round 0  [" in err and "walk.kanim: measuring  [" in err
+              and err.rsplit("\r", 1)[-1].startswith(CSI_ERASE), f"glTF export under a terminal: exit {code}, {err[-300:]!r}")
         code, out, err = run([keyanim, "decode", k, "-o", os.path.join(tmp, "back.bvh"), "-f"], tty=False)
         check(code == 0 and "\r" not in err, f"decode, not a terminal: {err!r}")
 

@@ -1,5 +1,5 @@
-// The progress callbacks of the BVH reader and the encoder (what keyanim's progress bar is built
-// on): their stages in order, fractions from 0 to 1 that never go back within a stage, calls on
+// The progress callbacks of the BVH reader, the encoder and the glTF export (what keyanim's
+// progress bar is built on): their stages in order, fractions from 0 to 1 that never go back within a stage, calls on
 // the caller's thread only, and results that do not depend on them.
 #include <doctest/doctest.h>
 
@@ -9,6 +9,7 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
+#include "keyanim/offline/gltf.h"
 
 using namespace keyanim::offline;
 
@@ -100,4 +101,29 @@ TEST_CASE("fixed key modes: fitting once, then measuring") {
   EncodeResult r;
   const std::vector<EncodeStage> runs = runs_of(encode_recording(m, s, r));
   CHECK(runs == std::vector<EncodeStage>{EncodeStage::fitting, EncodeStage::measuring});
+}
+
+TEST_CASE("glTF export: rounds of fitting and verifying, then measuring, and the same asset") {
+  const Motion m = walk();
+  EncodeResult r;
+  std::string error;
+  REQUIRE(encode(m, {}, r, error));
+  keyanim::Clip clip;
+  REQUIRE(keyanim::Clip::load(write_kanim(r.clip), clip) == keyanim::Status::ok);
+  GltfOptions options;
+  std::vector<Call> calls;
+  options.progress = [&](EncodeStage stage, double f) { calls.push_back({stage, f}); };
+  GltfOutput with, without;
+  GltfReport report;
+  REQUIRE(export_gltf(clip, options, with, report, error));
+  const std::vector<EncodeStage> runs = runs_of(calls);
+  REQUIRE(runs.size() == 2 * report.rounds + 1);
+  for (uint32_t i = 0; i < report.rounds; ++i) {
+    CHECK(runs[2 * i] == EncodeStage::fitting);
+    CHECK(runs[2 * i + 1] == EncodeStage::verifying);
+  }
+  CHECK(runs.back() == EncodeStage::measuring);
+  options.progress = nullptr;
+  REQUIRE(export_gltf(clip, options, without, report, error));
+  CHECK(with.main == without.main);
 }

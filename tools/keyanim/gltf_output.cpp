@@ -7,7 +7,9 @@
 #include <optional>
 
 #include "escape.h"
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/gltf.h"
+#include "progress.h"
 #include "report.h"
 #include "settings.h"
 
@@ -79,7 +81,11 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
   offline::GltfOutput asset;
   offline::GltfReport r;
   std::string error;
+  Progress bar(g, in);
+  EncodeProgress progress(&bar, o.fps == 0.0, false);
+  o.progress = progress.encoding();
   if (!offline::export_gltf(clip, o, asset, r, error)) fail(kUsage, in + ": glTF export: " + error);
+  bar.erase();
   if (bin && !asset.bin.empty()) {  // a clip without frames has no buffer: no .bin is left
     bin->write(asset.bin);
     bin->commit();

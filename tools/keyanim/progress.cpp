@@ -74,7 +74,7 @@ void Progress::erase() {
 
 // The model of EncodeProgress (progress.h): where each part starts on the bar.
 namespace {
-constexpr double kEncoderStart = 0.03, kCompressStart = 0.86;
+constexpr double kEncoderStart = 0.03;
 constexpr double kRoundZero = 0.25;  // error mode: round 0's share of the encoder's time
 constexpr double kDecay = 0.9;       // each later round's time over the one before
 constexpr double kMeasureStart = 0.98;
@@ -106,12 +106,12 @@ std::function<void(offline::EncodeStage, double)> EncodeProgress::encoding() {
       const double split = round_ == 0 ? 0.875 : 0.5;
       done = a + (b - a) * (stage == EncodeStage::fitting ? f * split : split + f * (1.0 - split));
     }
-    bar_->update(name, kEncoderStart + std::min(done, 1.0) * (kCompressStart - kEncoderStart));
+    bar_->update(name, kEncoderStart + std::min(done, 1.0) * (end_ - kEncoderStart));
   };
 }
 
 void EncodeProgress::compressing() {
-  if (bar_) bar_->update("compressing", kCompressStart);
+  if (bar_) bar_->update("compressing", end_);
 }
 
 }  // namespace keyanim::cli

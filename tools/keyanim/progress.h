@@ -51,8 +51,10 @@ class Progress {
 // estimate: a clip that needs many more rounds than usual spends longer near the end.
 class EncodeProgress {
  public:
-  // No bar (null, or not shown): nothing to do.
-  EncodeProgress(Progress* bar, bool error_mode) : bar_(bar && bar->shown() ? bar : nullptr), error_mode_(error_mode) {}
+  // No bar (null, or not shown): nothing to do. `then_compress` false: the encoder's stages end
+  // the bar (a glTF export has the same stages, and nothing after them worth a share).
+  EncodeProgress(Progress* bar, bool error_mode, bool then_compress = true)
+      : bar_(bar && bar->shown() ? bar : nullptr), error_mode_(error_mode), end_(then_compress ? 0.86 : 1.0) {}
   // For offline::BvhReadOptions::progress.
   std::function<void(double)> parsing();
   // For offline::EncodeSettings::progress.
@@ -63,6 +65,7 @@ class EncodeProgress {
  private:
   Progress* bar_;
   bool error_mode_;
+  double end_;  // where the encoder's stages end on the bar
   uint32_t round_ = 0;
   offline::EncodeStage last_ = offline::EncodeStage::fitting;
 };

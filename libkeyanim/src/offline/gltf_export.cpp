@@ -134,14 +134,17 @@ bool animate(const Clip& clip, const GltfOptions& options, const Window& w, doub
       for (size_t j = 0; j < sk.joints.size(); ++j)
         if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
     const double fit_tol = report.tolerance - kRoundingMargin * size;
-    if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error)) return false;
+    if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error, options.progress))
+      return false;
   }
   // Every export carries one animation spanning the range, even if nothing moves.
   bool animated = false;
   for (const NodeAnimation& n : model.nodes) animated = animated || n.translation || n.rotation;
   if (!animated && !sk.joints.empty()) model.nodes[0].translation = translation_sampler(nodes[0], curves, w);
 
-  const CheckResult check = check_model(model, reference, report.tolerance);
+  const CheckResult check = check_model(model, reference, report.tolerance, [&](double f) {
+    if (options.progress) options.progress(EncodeStage::measuring, f);
+  });
   report.max_error = check.max_error;
   report.worst_node = reference.owner(check.worst_point);
   report.worst_axis = reference.moved_by_owner(check.worst_point) ? int(check.worst_point - report.nodes) % 3 : -1;

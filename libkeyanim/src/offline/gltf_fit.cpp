@@ -228,7 +228,8 @@ std::string describe_failure(const Skeleton& sk, const Reference& ref, const Che
 }  // namespace
 
 bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
-              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error) {
+              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error,
+              const std::function<void(EncodeStage, double)>& progress) {
   const Skeleton& sk = model.skeleton;
   const Window& w = reference.window();
   std::vector<Target> targets;
@@ -246,13 +247,20 @@ bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vec
   }
   initial_budgets(targets, sk, reference, tolerance);
   std::vector<bool> refit(targets.size(), true);
+  const auto report = [&](EncodeStage stage, double f) {
+    if (progress) progress(stage, f);
+  };
   for (rounds = 1;; ++rounds) {
+    const size_t todo = size_t(std::count(refit.begin(), refit.end(), true));
+    size_t done = 0;
     for (size_t i = 0; i < targets.size(); ++i) {
       if (!refit[i]) continue;
       NodeAnimation& anim = model.nodes[targets[i].node];
       (targets[i].rotation() ? anim.rotation : anim.translation) = fit(targets[i], w, linear_only);
+      report(EncodeStage::fitting, double(++done) / double(todo));
     }
-    const CheckResult r = check_model(model, reference, tolerance);
+    report(EncodeStage::fitting, 1.0);
+    const CheckResult r = check_model(model, reference, tolerance, [&](double f) { report(EncodeStage::verifying, f); });
     if (r.violations.empty()) return true;
     refit = blame(r.violations, targets, target_of, sk, reference);
     bool any = false;

@@ -9,6 +9,7 @@
 
 #include "gltf_curves.h"
 #include "gltf_verify.h"
+#include "keyanim/offline/encode.h"
 
 namespace keyanim::offline::gltf {
 
@@ -16,8 +17,9 @@ namespace keyanim::offline::gltf {
 // with linear_only, .translation for every node whose translation leaves its OFFSET), so that
 // check_model(model, reference, tolerance) finds no violation. Other tracks already in the model
 // stay. Returns false with `error` if float32 keys cannot hold the tolerance. `rounds` receives
-// the number of verification rounds.
+// the number of verification rounds. `progress` as GltfOptions::progress (fitting, verifying).
 bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
-              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error);
+              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error,
+              const std::function<void(EncodeStage, double)>& progress = {});
 
 }  // namespace keyanim::offline::gltf

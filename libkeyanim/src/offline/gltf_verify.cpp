@@ -43,7 +43,8 @@ void pose_points(const Skeleton& skeleton, const std::vector<Vec3>& positions, c
     }
 }
 
-CheckResult check_model(const Model& model, const Reference& reference, double tolerance) {
+CheckResult check_model(const Model& model, const Reference& reference, double tolerance,
+                        const std::function<void(double)>& progress) {
   CheckResult result;
   const Window& w = reference.window();
   const uint32_t np = reference.point_count();
@@ -51,6 +52,7 @@ CheckResult check_model(const Model& model, const Reference& reference, double t
   std::vector<Mat3> rotations;
   std::vector<double> worst(np);
   for (uint32_t i = 0; i < w.frames(); ++i) {
+    if (progress && i % 64 == 0) progress(double(i) / double(w.frames()));
     std::fill(worst.begin(), worst.end(), 0.0);
     for (QuatLerp lerp : kQuatLerps) {
       play_pose(model, w.time(w.first + i), lerp, positions, rotations);
@@ -70,6 +72,7 @@ CheckResult check_model(const Model& model, const Reference& reference, double t
       if (!(worst[p] <= tolerance)) result.violations.push_back({p, i, worst[p]});
     }
   }
+  if (progress) progress(1.0);
   return result;
 }
 

@@ -2,6 +2,7 @@
 // window (the reference) against a glTF player's, over joints, End Sites and shell points.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "gltf_curves.h"
@@ -53,6 +54,8 @@ struct CheckResult {
 
 // Plays the model at every source frame of the window with each LINEAR-rotation reading
 // (gltf_player.h) and compares with the reference.
-CheckResult check_model(const Model& model, const Reference& reference, double tolerance);
+// `progress`, if given, gets the fraction of the frames checked.
+CheckResult check_model(const Model& model, const Reference& reference, double tolerance,
+                        const std::function<void(double)>& progress = {});
 
 }  // namespace keyanim::offline::gltf

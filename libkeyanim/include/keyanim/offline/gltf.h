@@ -23,11 +23,14 @@
 // units (glTF assumes metres: a viewer may need to scale a clip captured in centimetres).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "keyanim/clip.h"
 
 namespace keyanim::offline {
+
+enum class EncodeStage : uint8_t;  // encode.h
 
 struct GltfOptions {
   // World-space tolerance of the fit, in file length units, or in percent of the
@@ -54,6 +57,11 @@ struct GltfOptions {
   // (relative, e.g. "walk.bin"), returned separately.
   std::string bin_uri;
   std::string name = "keyanim";      // the animation's name
+  // Defaults to none. Called as export_gltf() works, with the stages of encode() (encode.h):
+  // rounds of fitting keys (the fraction of the tracks refitted) and verifying them as a player
+  // computes them (the fraction of the frames), until within the tolerance; then measuring the
+  // report. With fps, measuring only. On the calling thread; the output does not depend on it.
+  std::function<void(EncodeStage stage, double fraction)> progress;
 };
 
 struct GltfReport {
