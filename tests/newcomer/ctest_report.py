@@ -24,7 +24,8 @@ def main():
         out = case.findtext("system-out") or ""
         if case.find("skipped") is not None or status in ("notrun", "skipped", "disabled"):
             reason = REASON.search(out)
-            skipped.append((name, reason.group(0).strip() if reason else "(no reason printed)"))
+            last = [l for l in out.splitlines() if l.strip()][-1:]  # else: a script's last word
+            skipped.append((name, reason.group(0).strip() if reason else last[0] if last else "(no reason printed)"))
         elif case.find("failure") is not None or status == "fail":
             failed.append(name)
         elif any(p.search(out) for p in EMPTY_PASS):
