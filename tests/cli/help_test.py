@@ -40,15 +40,16 @@ def described(section):
 
 
 def usage_options(text, command):
-    """Options named in the usage lines: 'usage: keyanim CMD ...' and its indented continuations."""
+    """Options named in the usage lines: 'usage: keyanim CMD ...', its other forms ('  or:  keyanim
+    CMD ...') and their indented continuations."""
     lines = text.splitlines()
     start = next(i for i, l in enumerate(lines) if l.startswith(f"usage: keyanim {command}"))
     usage = [lines[start]]
     for line in lines[start + 1:]:
-        if not line.startswith(" " * 8):
+        if not (line.startswith(" " * 8) or line.startswith(f"  or:  keyanim {command} ")):
             break
         usage.append(line)
-    return set(OPTION.findall(" ".join(usage).split(command, 1)[1]))
+    return set(OPTION.findall(" ".join(usage).replace(f"keyanim {command}", "")))
 
 
 def check_command(keyanim, command, fail):

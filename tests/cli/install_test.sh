@@ -75,6 +75,9 @@ completion)
   expect "HOP.BVH sub walk.bvh walk.kanim " info ""
   expect "HOP.BVH sub walk.bvh " view walk.kanim --against ""
   expect "sub " plot walk.bvh -o ""
+  expect "HOP.BVH notes.txt sub walk.bvh walk.kanim " encode --manifest ""   # LIST: any file
+  touch r.jsonl
+  expect "r.jsonl sub " eval walk.bvh --report ""
   expect "walk.bvh walk.kanim " --max-input 1G info w
   ;;
 *) die "unknown case $CASE" ;;

@@ -51,14 +51,15 @@ int run_batch(size_t count, unsigned threads, const Globals& g, const std::funct
   std::vector<int> codes(count, kOk);
   std::atomic<size_t> next{0};
   std::mutex out_mutex;
-  // The bar counts bytes of input done, so that its time left holds with files of all sizes.
+  // The bar counts bytes of input done, so that its time left holds with files of all sizes
+  // (inputs, for a list so long that asking every size first would delay the start: a manifest).
   Globals shown = g;
   if (count < 2) shown.verbosity = 0;
   Progress bar(shown, std::to_string(count) + " inputs");
   std::vector<uint64_t> sizes(count, 1);
   uint64_t total = 0, done_bytes = 0;
   size_t done = 0;
-  for (size_t i = 0; i < count && bar.shown(); ++i) {
+  for (size_t i = 0; i < count && bar.shown() && count <= 10000; ++i) {
     std::error_code ec;
     sizes[i] = std::max<uint64_t>(1, std::filesystem::file_size(names[i], ec));
   }

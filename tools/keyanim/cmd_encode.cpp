@@ -21,6 +21,8 @@ namespace keyanim::cli {
 const char* const kEncodeHelp =
     "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--keys MODE]\n"
     "                      [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
+    "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
+    "                      [--report R.jsonl] [--error E|E%] [--keys MODE] [-j N] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode).\n"
     "  -o, --output FILE     output (default: IN with .kanim; '-' = standard output).\n"
     "                        IN may be a directory: every .bvh below it is encoded to the same\n"
@@ -30,7 +32,6 @@ const char* const kEncodeHelp =
     "                        stop the run before any file is encoded.\n"
     "  -j N                  threads (default and most: one per core): a file's channels, or\n"
     "                        a directory's (or a manifest's) files\n"
-    "      keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing] [--report R.jsonl]\n"
     "  --manifest LIST       encode every path listed (one per line; '-': standard input) to the\n"
     "                        same path below OUTDIR, as .kanim (an absolute path loses its root)\n"
     "  --shard I/N           only entries I, I+N, I+2N, ... (0 <= I < N): N machines, no coordination\n"

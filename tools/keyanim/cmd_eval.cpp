@@ -30,15 +30,16 @@ const char* const kEvalHelp =
     "by zstd -19, the max and RMS world-space error with the worst joint and frame, and the\n"
     "encode and decode times. Nothing is written.\n"
     "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
-    "  --keys A+B+...        several key modes (each as below), every one at every tolerance\n"
     "  --svg RD.svg          compression ratio against error, log axes: a line per file, or\n"
     "                        with several key modes a line per mode over every file\n"
     "  --report R.jsonl      the figures as JSON lines, one per file and setting, then a total\n"
     "                        per setting with the bytes per second of motion over every file\n"
     "  -j N                  threads (default: one per core)\n"
     "  --json                one JSON object on standard output\n"
-    "With --keys other than error, --error only guides quantization: the error reached is\n"
-    "reported as it is, under the heading --error, with a warning where it exceeds a given --error.\n";
+    "--keys takes several modes joined by + (error+uniform:10+curvature): every one is run at\n"
+    "every tolerance. With --keys other than error, --error only guides quantization: the error\n"
+    "reached is reported as it is, under the heading --error, with a warning where it exceeds a\n"
+    "given --error.\n";
 
 namespace {
 

@@ -13,7 +13,8 @@ function(run var)
   set(${var} "${out}" PARENT_SCOPE)
 endfunction()
 
-# roff(VAR): one command's help text as man(7) markup. Lines are: the usage (and its indented
+# roff(VAR): one command's help text as man(7) markup (every line of text starts with \& so that
+# none is taken for a request). Lines are: the usage (its other forms, and their indented
 # continuations), option entries ("  -x, --long ARG   text", continued at 20+ spaces), bullets
 # ("  - text") and plain paragraph lines.
 function(roff var text)
@@ -27,25 +28,27 @@ function(roff var text)
     if(line MATCHES "^usage: (keyanim [a-z]+) (.*)$")
       string(APPEND out ".PP\n\\fB${CMAKE_MATCH_1}\\fR ${CMAKE_MATCH_2}\n")
       set(state usage)
+    elseif(line MATCHES "^  or:  (keyanim [a-z]+) (.*)$")  # another form of the usage
+      string(APPEND out ".br\n\\fB${CMAKE_MATCH_1}\\fR ${CMAKE_MATCH_2}\n")
+      set(state usage)
     elseif(line MATCHES "^  (\\\\-[^ ].*[^ ])  +([^ ].*)$")
-      string(APPEND out ".TP\n\\fB${CMAKE_MATCH_1}\\fR\n${CMAKE_MATCH_2}\n")
+      string(APPEND out ".TP\n\\fB${CMAKE_MATCH_1}\\fR\n\\&${CMAKE_MATCH_2}\n")
       set(state item)
     elseif(line MATCHES "^  \\\\- (.*)$")
-      string(APPEND out ".IP \\(bu 2\n${CMAKE_MATCH_1}\n")
+      string(APPEND out ".IP \\(bu 2\n\\&${CMAKE_MATCH_1}\n")
       set(state item)
     elseif(line MATCHES "^ +([^ ].*)$" AND state)
-      string(APPEND out "${CMAKE_MATCH_1}\n")
+      string(APPEND out "\\&${CMAKE_MATCH_1}\n")
     elseif(line STREQUAL "")
       set(state "")
     else()
       if(NOT state STREQUAL "para")
         string(APPEND out ".PP\n")
       endif()
-      string(APPEND out "${line}\n")
+      string(APPEND out "\\&${line}\n")
       set(state para)
     endif()
   endforeach()
-  string(REGEX REPLACE "(^|\n)([.'][^A-Z])" "\\1\\\\&\\2" out "${out}")  # text, not a request
   string(REPLACE "<semicolon>" ";" out "${out}")
   set(${var} "${out}" PARENT_SCOPE)
 endfunction()
