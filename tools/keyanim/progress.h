@@ -44,11 +44,12 @@ class Progress {
 
 // The stages of encoding one file as parts of one bar: parsing the BVH, the encoder's own stages
 // (error mode: rounds of fitting and verifying until every joint is within the tolerance; their
-// number is not known in advance), compressing. The shares and the rounds' model are measured
-// (keyanim 0.2, one thread, CMU 01_01 made 44,032 frames long and 12 corpus clips): parsing
-// about 3% of the time, the encoder 83% (error mode: round 0 a quarter of it, each later round
-// about 0.9 times the one before, 15 to 31 rounds), compressing 14%. The time left is an
-// estimate: a clip that needs many more rounds than usual spends longer near the end.
+// number is not known in advance), compressing. The shares and the rounds' model come from one
+// thread's wall-clock stage times (a shared 2-core machine: rough) on CMU 01_01 made 44,032
+// frames long and on 12 corpus clips: parsing about 3% of the time, the encoder 83% (error
+// mode: round 0 a quarter of it, each later round about 0.9 times the one before, 15 to 31
+// rounds), compressing 14%. The time left is an estimate: a clip that needs many more rounds
+// than usual spends longer near the end.
 class EncodeProgress {
  public:
   // No bar (null, or not shown): nothing to do. `then_compress` false: the encoder's stages end
