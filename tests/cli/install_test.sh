@@ -19,7 +19,8 @@ man)
   page=$T/prefix/share/man/man1/keyanim.1
   [ -f "$page" ] || die "no share/man/man1/keyanim.1 installed"
   MANWIDTH=80 man -l "$page" >"$T/page.txt" 2>"$T/man.err" || die "man -l failed: $(cat "$T/man.err")"
-  [ ! -s "$T/man.err" ] || die "man -l warned: $(cat "$T/man.err")"
+  # (A complaint about the locale is the machine's, not the page's.)
+  ! grep -v 'locale' "$T/man.err" | grep -q . || die "man -l warned: $(cat "$T/man.err")"
   for section in NAME SYNOPSIS DESCRIPTION COMMANDS; do
     grep -q "^$section" "$T/page.txt" || die "the page has no $section section"
   done
