@@ -24,7 +24,7 @@ void FitScratch::prepare(size_t frames) {
 
 CurveFit::CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule,
                    FitScratch& scratch)
-    : y_(y), frames_(frames), interp_(interp), s_(s), rule_(rule), w_(scratch) {
+    : y_(y), interp_(interp), s_(s), rule_(rule), w_(scratch) {
   w_.prepare(frames);
 }
 

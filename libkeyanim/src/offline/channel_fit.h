@@ -111,7 +111,6 @@ class CurveFit {
   bool try_remove(uint32_t f);
 
   const double* y_;
-  uint32_t frames_;
   Tolerance tol_;
   double step_ = 1.0;
   Interpolation interp_;
