@@ -13,7 +13,7 @@
 #     (tests/cli/help_test.py); `man keyanim` and the bash completion found;
 #  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
 #     as skipped with their reason, and no test may pass without checking anything
-#     (tests/newcomer/ctest_report.py).
+#     (tests/ctest_report.py).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 PY=/usr/bin/python3
@@ -59,5 +59,5 @@ printf '%s\n' "$tests"
 KEYANIM_SKIP_SANITIZE=1 KEYANIM_PROPERTY_SECONDS=10 bash -euo pipefail -c "$tests" 2>&1 | tee "$T/test.log"
 grep -q "corpus not found beside the checkout: the corpus tests listed as Skipped above did not run" "$T/test.log" ||
   { echo "newcomer: FAIL: the test command does not say why tests were skipped"; exit 1; }
-"$PY" tests/newcomer/ctest_report.py build/ctest-results.xml --expect-skips
+"$PY" tests/ctest_report.py build/ctest-results.xml --expect-skips
 step "ok"

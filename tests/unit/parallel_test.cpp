@@ -89,7 +89,7 @@ TEST_SUITE("parallel") {
     CHECK(what == "job 3");
   }
 
-  TEST_CASE("zero threads means one per core; workers are numbered below parallel_workers") {
+  TEST_CASE("zero threads means one per core, and workers are numbered below parallel_workers") {
     CHECK(resolve_threads(0) >= 1);
     CHECK(resolve_threads(3) == 3);
     CHECK(keyanim::offline::parallel_workers(2, 8) == 2);

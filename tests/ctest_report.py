@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""What CTest's JUnit report (ctest --output-junit) says about skipped tests:
-ctest_report.py RESULTS.xml [--expect-skips]
+"""What CTest's JUnit report (ctest --output-junit) says about skipped tests, for scripts/test.sh
+and scripts/newcomer.sh: ctest_report.py RESULTS.xml [--expect-skips]
 
 Lists the skipped tests with their reason (the line of their output that says why), and fails
 when a test passed without checking anything, which is how a skip that reports itself as a pass
-looks: a doctest case with no assertion ("assertions: 0"), a node:test file with no passing
-test ("# pass 0"). With --expect-skips (a clone without ../shared), at least one test must be
+looks, or a doctest case whose name CTest cut at a ';' (its filter then matches nothing): a
+doctest case with no assertion ("assertions: 0"), a node:test file with no passing test
+("# pass 0"). With --expect-skips (a clone without ../shared), at least one test must be
 skipped.
 """
 import re
