@@ -37,14 +37,32 @@ Motion tree(uint32_t frames) {
 }  // namespace
 
 TEST_SUITE("budget") {
-  TEST_CASE("reach below is the longest chain of translations under each node") {
+  TEST_CASE("reach below is the longest chain of translations under each node, to a point or a shell point") {
     Motion m = tree(3);
     m.values[2 * 12 + 1] = 7.0;  // Hips' Yposition at frame 2: its own translation, not below it
-    const std::vector<double> down = reach_below(m);
+    std::vector<double> down = reach_below(m, 0.0);
     CHECK(down[0] == 7.0);  // Spine 3 + End 4 beats Leg 5 + End 0
     CHECK(down[1] == 4.0);
     CHECK(down[2] == 0.0);
     CHECK(down[3] == 0.0);
+    down = reach_below(m, 1.5);  // shell points 1.5 from every joint
+    CHECK(down[0] == 7.0);       // Spine's End Site (7) beats Spine's shell (3 + 1.5) and Leg's (5 + 1.5)
+    CHECK(down[1] == 4.0);
+    CHECK(down[2] == 0.0);
+    CHECK(down[3] == 1.5);  // its own shell points
+    down = reach_below(m, 3.0);
+    CHECK(down[0] == 8.0);  // Leg's shell: 5 + 3
+    CHECK(down[1] == 4.0);
+  }
+
+  TEST_CASE("reach below takes the longer of both readings of a position channel below the root") {
+    Motion m = tree(2);
+    m.skeleton.joints[1].channels.push_back(kYp);  // Spine: Yposition, OFFSET y 3
+    m.skeleton.assign_channel_columns();
+    m.values.assign(2 * 13, 0.0);
+    m.values[1 * 13 + 9] = 2.0;  // frame 1: Spine's Yposition 2 -> replace 2, add 5
+    const std::vector<double> down = reach_below(m, 0.0);
+    CHECK(down[0] == 9.0);  // add: 3 + 2, then the End Site's 4
   }
 
   TEST_CASE("first budgets: the tolerance for translations, its angle at the reach for rotations") {
@@ -56,6 +74,9 @@ TEST_SUITE("budget") {
     for (int c = 3; c < 6; ++c) CHECK(base[c] == doctest::Approx(tol / 7.0 * deg));
     for (int c = 6; c < 9; ++c) CHECK(base[c] == doctest::Approx(tol / 4.0 * deg));
     for (int c = 9; c < 12; ++c) CHECK(base[c] == doctest::Approx(tol / shell * deg));  // nothing below: the shell
+    // Without a shell, a rotation that moves no measured point gets the largest budget.
+    const std::vector<double> no_shell = base_tolerances(m, tol, 0.0);
+    for (int c = 9; c < 12; ++c) CHECK(no_shell[c] == 180.0);
   }
 
   TEST_CASE("an over node tightens exactly the channels that move it, by the smallest ratio") {
@@ -87,6 +108,11 @@ TEST_SUITE("budget") {
     b.changed_frames(0, frames);
     CHECK(frames == std::vector<uint32_t>{1});
     CHECK(b.tolerance(9).at(1) == doctest::Approx(0.9));
+    // A shell point of Leg over: its own rotation moves it, with Hips' channels.
+    b.tighten(0, {{3, 0.6, true}});
+    CHECK(b.take_dirty() == std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 9, 10, 11});
+    CHECK(b.tolerance(9).at(0) == doctest::Approx(0.6));
+    CHECK(b.tolerance(6).at(0) == 1.0);
   }
 
   TEST_CASE("tolerances are stored rounded down, never looser than computed") {

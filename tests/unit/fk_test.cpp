@@ -510,12 +510,12 @@ TEST_CASE("metrics identical motions have zero error") {
   const auto r = keyanim::offline::measure_error(a, a);
   CHECK(r.max_error == 0.0);
   CHECK(r.rms_error == 0.0);
-  CHECK(r.max_leaf_rotation == 0.0);
+  CHECK(r.shell == doctest::Approx(0.02 * 5.0));  // 2% of the rest pose box: 3 x 5 x 0
   CHECK(r.joint_max == std::vector<double>(6, 0.0));
   CHECK(r.channel_max == std::vector<double>(13, 0.0));
 }
 
-TEST_CASE("metrics hand-computed errors worst node and frame and channels") {
+TEST_CASE("metrics hand-computed errors worst node and frame and channels (joints and End Sites only)") {
   Motion original = metrics_motion();
   Motion decoded = metrics_motion();
   for (uint32_t f = 0; f < 3; ++f) {
@@ -532,10 +532,13 @@ TEST_CASE("metrics hand-computed errors worst node and frame and channels") {
   const double deg = std::numbers::pi / 180.0;
   const double e1 = 2 * 3 * std::sin(5 * deg);
   const double e2 = 2 * 3 * std::sin(2 * deg);
-  auto r = keyanim::offline::measure_error(original, decoded);
+  auto r = keyanim::offline::measure_error(original, decoded, 0.0);
   CHECK(r.max_error == doctest::Approx(e1).epsilon(1e-12));
   CHECK(r.worst_joint == 2);
+  CHECK(r.worst_point == 0);
   CHECK(r.worst_frame == 1);
+  CHECK(r.shell == 0.0);
+  CHECK_FALSE(r.both_readings);
   const double rms = std::sqrt((6 * 0.25 * 0.25 + e1 * e1 + e2 * e2) / 18.0);
   CHECK(r.rms_error == doctest::Approx(rms).epsilon(1e-12));
   REQUIRE(r.joint_max.size() == 6);
@@ -547,15 +550,72 @@ TEST_CASE("metrics hand-computed errors worst node and frame and channels") {
     CAPTURE(c);
     CHECK(r.channel_max[c] == doctest::Approx(want[c]).epsilon(1e-12));
   }
-  // Head's 7 degrees count; Arm's 10 do not (its End Site has length).
-  CHECK(r.max_leaf_rotation == doctest::Approx(7.0).epsilon(1e-12));
 
-  // Tip (no children at all) counts too.
+  // Tip (no children at all): its rotation moves no joint or End Site.
   set(decoded, 2, 12, -12.5);
-  r = keyanim::offline::measure_error(original, decoded);
+  r = keyanim::offline::measure_error(original, decoded, 0.0);
   CHECK(r.channel_max[12] == doctest::Approx(12.5).epsilon(1e-12));
-  CHECK(r.max_leaf_rotation == doctest::Approx(12.5).epsilon(1e-12));
-  CHECK(r.max_error == doctest::Approx(e1).epsilon(1e-12));  // Tip's rotation moved nothing
+  CHECK(r.max_error == doctest::Approx(e1).epsilon(1e-12));
+}
+
+TEST_CASE("metrics shell points see a rotation that moves no joint or End Site") {
+  const double deg = std::numbers::pi / 180.0;
+  const double d = 0.5;  // shell distance
+  Motion original = metrics_motion();
+  Motion decoded = metrics_motion();
+  set(decoded, 1, 10, 7.0);   // frame 1: Head X 7 degrees (its End Site has zero length)
+  set(decoded, 2, 12, 40.0);  // frame 2: Tip Y 40 degrees (no children at all)
+  CHECK(keyanim::offline::measure_error(original, decoded, 0.0).max_error == 0.0);
+  const auto r = keyanim::offline::measure_error(original, decoded, d);
+  // A rotation by a about one axis moves the shell points on the other two by the chord 2 d sin(a/2).
+  const double head = 2 * d * std::sin(3.5 * deg), tip = 2 * d * std::sin(20 * deg);
+  CHECK(r.shell == d);
+  CHECK(r.max_error == doctest::Approx(tip).epsilon(1e-12));
+  CHECK(r.worst_joint == 5);
+  CHECK(r.worst_frame == 2);
+  CHECK((r.worst_point == 1 || r.worst_point == 3));  // Tip's x or z shell point, not y (its axis)
+  CHECK(keyanim::offline::point_name(original.skeleton, 5, r.worst_point) ==
+        std::string("Tip shell ") + char('x' + r.worst_point - 1));
+  CHECK(r.joint_max[3] == doctest::Approx(head).epsilon(1e-12));
+  CHECK(r.joint_max[4] == 0.0);  // Head's End Site: a point, no shell
+  CHECK(r.joint_max[0] == 0.0);
+  // The rms is over nodes and frames of each node's largest point error.
+  CHECK(r.rms_error == doctest::Approx(std::sqrt((head * head + tip * tip) / 18.0)).epsilon(1e-12));
+}
+
+TEST_CASE("metrics position channels below the root are measured under both readings") {
+  // Hips (Zr) -> Arm, OFFSET (0,5,0), channels Xp Yp Zp Zr with values (0,5,0): replace gives
+  // the translation (0,5,0), add (0,10,0) -> End Site (3,0,0).
+  Motion m;
+  m.skeleton = skeleton_of({joint("Hips", -1, {0, 0, 0}, {kZr}), joint("Arm", 0, {0, 5, 0}, {kXp, kYp, kZp, kZr}),
+                            end_site(1, {3, 0, 0})});
+  m.frame_count = 1;
+  m.frame_time = 1.0 / 30;
+  m.values = {0, 0, 5, 0, 0};
+  Motion decoded = m;
+  decoded.values[0] = 2.0;  // Hips Z 2 degrees: each point moves by 2 |p| sin(1 degree)
+  const double deg = std::numbers::pi / 180.0;
+  const auto r = keyanim::offline::measure_error(m, decoded, 0.0);
+  CHECK(r.both_readings);
+  CHECK(r.worst_reading == keyanim::PositionReading::add);
+  CHECK(r.worst_joint == 2);
+  CHECK(r.max_error == doctest::Approx(2 * std::sqrt(109.0) * std::sin(deg)).epsilon(1e-12));
+  CHECK(r.joint_max[1] == doctest::Approx(2 * 10 * std::sin(deg)).epsilon(1e-12));
+  // FK itself under each reading.
+  std::vector<Vec3> replaced, added;
+  keyanim::offline::world_positions(m.skeleton, m.values.data(), replaced, keyanim::PositionReading::replace);
+  keyanim::offline::world_positions(m.skeleton, m.values.data(), added, keyanim::PositionReading::add);
+  CHECK(replaced[2] == Vec3{3, 5, 0});
+  CHECK(added[2] == Vec3{3, 10, 0});
+  // Position channels on a root alone: one reading (a root's OFFSET shifts both poses alike).
+  Motion root_only = m;
+  root_only.skeleton = skeleton_of({joint("Hips", -1, {1, 2, 3}, {kXp, kYp, kZp, kZr}), end_site(0, {3, 0, 0})});
+  root_only.values = {0, 0, 0, 0};
+  Motion moved = root_only;
+  moved.values[3] = 2.0;
+  const auto one = keyanim::offline::measure_error(root_only, moved, 0.0);
+  CHECK_FALSE(one.both_readings);
+  CHECK(one.max_error == doctest::Approx(2 * 3 * std::sin(deg)).epsilon(1e-12));
 }
 
 TEST_CASE("metrics modulo 360 channel comparison") {
@@ -571,7 +631,6 @@ TEST_CASE("metrics modulo 360 channel comparison") {
   CHECK(r.channel_max[11] == doctest::Approx(180.0).epsilon(1e-12));
   CHECK(r.channel_max[10] == 0.0);
   CHECK(r.channel_max[0] == 540.0);
-  CHECK(r.max_leaf_rotation == doctest::Approx(180.0).epsilon(1e-12));
 }
 
 TEST_CASE("metrics mismatched or broken motions report infinity") {

@@ -10,6 +10,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/metrics.h"
 #include "offline/verify.h"
+#include "shell_reference.h"
 
 using namespace keyanim;
 using namespace keyanim::offline;
@@ -125,55 +126,70 @@ TEST_SUITE("verify") {
   }
 
   TEST_CASE("window verification finds exactly the nodes measure_error finds over") {
-    // A two-bone arm, its encoding at a coarse uniform key interval, and a tolerance between
-    // the smallest and largest errors: the over nodes are those the report says are over.
+    // A two-bone arm (with a twisting forearm, and in the second variant a position channel on
+    // the Arm, read both ways), its encoding at a coarse uniform key interval, and a tolerance
+    // between the smallest and largest errors: the over nodes are those an independent FK
+    // (shell_reference.h) finds over, on joints, End Sites and shell points.
+    for (const bool position_below_root : {false, true}) {
+    CAPTURE(position_below_root);
     Motion m;
+    const ChannelType arm_y = position_below_root ? ChannelType::y_position : ChannelType::y_rotation;
     m.skeleton.joints = {{"Root", -1, {0, 0, 0}, {ChannelType::x_position, ChannelType::z_rotation}},
-                         {"Arm", 0, {0, 5, 0}, {ChannelType::z_rotation}},
+                         {"Arm", 0, {0, 5, 0}, {ChannelType::z_rotation, arm_y}},
                          {"", 1, {0, 5, 0}, {}, true}};
     m.skeleton.assign_channel_columns();
     m.frame_count = 300;
     m.frame_time = 1.0 / 30.0;
     for (uint32_t f = 0; f < 300; ++f) {
       const double t = f / 30.0;
-      m.values.insert(m.values.end(), {std::sin(t), 30.0 * std::sin(2.1 * t), 40.0 * std::cos(1.3 * t)});
+      const double y = position_below_root ? 5.0 + 0.3 * std::sin(1.7 * t) : 50.0 * std::sin(0.9 * t);
+      m.values.insert(m.values.end(), {std::sin(t), 30.0 * std::sin(2.1 * t), 40.0 * std::cos(1.3 * t), y});
     }
     EncodedClip clip;
     clip.skeleton = m.skeleton;
     clip.frame_count = 300;
     clip.frame_time = m.frame_time;
-    for (uint32_t c = 0; c < 3; ++c) {
+    for (uint32_t c = 0; c < 4; ++c) {
       EncodedChannel ch;
       ch.step = 0.001;
-      for (uint32_t f = 0; f < 300; f += 37) ch.frames.push_back(f), ch.q.push_back(std::llround(m.values[f * 3 + c] / 0.001));
+      for (uint32_t f = 0; f < 300; f += 37) ch.frames.push_back(f), ch.q.push_back(std::llround(m.values[f * 4 + c] / 0.001));
       clip.channels.push_back(ch);
     }
     Motion decoded;
     std::string error;
     REQUIRE(decode_motion(to_clip(clip), {}, decoded, error));
-    const ErrorReport report = measure_error(m, decoded);
+    const double shell = 2.5;
+    const ErrorReport report = measure_error(m, decoded, shell);
+    CHECK(report.both_readings == position_below_root);
     const double tol = 0.5 * report.max_error;
     FrameMarks marks(300, 3);
     marks.mark_all();
     std::vector<OverNode> over;
     VerifyScratch scratch;
     for (uint32_t first = 0; first < 300; first += 64)
-      verify_window(m, clip.channels, clip.tangent_rule, tol, first, std::min(64u, 300 - first), marks, over, scratch);
-    // Independently: FK of both motions, node by node.
-    std::vector<Vec3> a, b;
-    size_t want = 0, matched = 0;
+      verify_window(m, clip.channels, clip.tangent_rule, tol, shell, first, std::min(64u, 300 - first), marks, over,
+                    scratch);
+    // Independently: the reference FK of both motions, node by node, the worse reading.
+    size_t want = 0, matched = 0, shells = 0;
     for (uint32_t f = 0; f < 300; ++f) {
-      world_positions(m.skeleton, m.frame(f), a);
-      world_positions(m.skeleton, decoded.frame(f), b);
+      std::vector<test::NodeError> e(3);
+      for (const test::Reading r : {test::Reading::replace, test::Reading::add}) {
+        if (r == test::Reading::add && !test::has_position_channels(m.skeleton)) continue;
+        const auto one = test::node_errors(m.skeleton, m.frame(f), decoded.frame(f), shell, r);
+        for (uint32_t d = 0; d < 3; ++d)
+          e[d].all = std::max(e[d].all, one[d].all), e[d].shell = std::max(e[d].shell, one[d].shell);
+      }
       for (uint32_t d = 0; d < 3; ++d) {
-        const double e = std::hypot(a[d][0] - b[d][0], a[d][1] - b[d][1], a[d][2] - b[d][2]);
-        if (e <= tol) continue;
+        if (e[d].all <= tol) continue;
         ++want;
         for (const OverNode& o : over)
-          if (o.frame == f && o.node == d && o.error == doctest::Approx(e).epsilon(1e-12)) ++matched;
+          if (o.frame == f && o.node == d && o.error == doctest::Approx(double(e[d].all)).epsilon(1e-9) &&
+              o.shell == (e[d].shell > tol))
+            ++matched, shells += o.shell;
       }
     }
     CHECK(want > 0);
+    CHECK(shells > 0);
     CHECK(over.size() == want);
     CHECK(matched == want);
     // Marks: over frames stay marked for a full check; nothing else is.
@@ -186,13 +202,14 @@ TEST_SUITE("verify") {
     FrameMarks some(300, 3);
     some.mark(1, 10, 12);
     std::vector<OverNode> only;
-    verify_window(m, clip.channels, clip.tangent_rule, 0.0, 0, 64, some, only, scratch);
+    verify_window(m, clip.channels, clip.tangent_rule, 0.0, shell, 0, 64, some, only, scratch);
     for (const OverNode& o : only) {
       CHECK(o.node != 0);
       CHECK(o.frame >= 10);
       CHECK(o.frame <= 12);
     }
     CHECK(only.size() >= 3);  // with a tolerance of 0, whatever moved is over
+    }
   }
 
   TEST_CASE("the final measurement is measure_error's report on the decoded motion") {
@@ -217,13 +234,14 @@ TEST_SUITE("verify") {
     Motion decoded;
     std::string error;
     REQUIRE(decode_motion(to_clip(clip), {}, decoded, error));
-    const ErrorReport want = measure_error(m, decoded);
+    const ErrorReport want = measure_error(m, decoded, 0.25);
     for (unsigned threads : {1u, 2u, 3u}) {
-      const ErrorReport got = measure_encoded(m, clip, threads);
+      const ErrorReport got = measure_encoded(m, clip, 0.25, threads);
       CHECK(got.max_error == want.max_error);
       CHECK(got.rms_error == want.rms_error);
       CHECK(got.worst_frame == want.worst_frame);
       CHECK(got.worst_joint == want.worst_joint);
+      CHECK(got.worst_point == want.worst_point);
       CHECK(got.joint_max == want.joint_max);
       CHECK(got.channel_max == want.channel_max);
     }

@@ -98,6 +98,13 @@ uint32_t Args::get_uint(const std::string& name, uint32_t fallback) const {
   return v ? parse_uint(name, *v) : fallback;
 }
 
+PositionReading position_reading(const Args& args) {
+  const std::optional<std::string> v = args.get("--position-channels");
+  if (!v || *v == "replace") return PositionReading::replace;
+  if (*v == "add") return PositionReading::add;
+  fail(kUsage, "--position-channels expects replace or add, got '" + *v + "'");
+}
+
 uint64_t parse_size(const std::string& option, const std::string& text) {
   uint64_t v = 0;
   const char* end = text.data() + text.size();

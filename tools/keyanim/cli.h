@@ -77,6 +77,9 @@ class Args {
 
 double parse_double(const std::string& option, const std::string& text);
 uint32_t parse_uint(const std::string& option, const std::string& text);
+// --position-channels replace|add (default replace): how position channels below the root
+// combine with OFFSET when posing (keyanim/pose.h). Usage error for another value.
+PositionReading position_reading(const Args& args);
 // "1000", "64K", "512M", "2G", "1T" (powers of 1024); at least 1.
 uint64_t parse_size(const std::string& option, const std::string& text);
 

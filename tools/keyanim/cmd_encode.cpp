@@ -19,11 +19,12 @@
 namespace keyanim::cli {
 
 const char* const kEncodeHelp =
-    "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--keys MODE]\n"
-    "                      [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
+    "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--shell D|D%]\n"
+    "                      [--keys MODE] [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
     "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
     "                      [--report R.jsonl] [--error E|E%] [--keys MODE] [-j N] [-f]\n"
-    "Stores only keyframes; every frame decodes within the tolerance (error mode).\n"
+    "Stores only keyframes; every frame decodes within the tolerance (error mode): every joint,\n"
+    "End Site and shell point (--shell) stays within --error of the original.\n"
     "  -o, --output FILE     output (default: IN with .kanim; '-' = standard output).\n"
     "                        IN may be a directory: every .bvh below it is encoded to the same\n"
     "                        relative path below -o OUTDIR, in parallel; bad files are reported\n"
@@ -102,9 +103,12 @@ std::string human_line(const nlohmann::json& j) {
   std::ostringstream line;
   line << j["input"].get<std::string>() << " -> " << j["output"].get<std::string>() << ": " << j["kanim_bytes"]
        << " bytes, " << j["ratio_raw_f32"].get<double>() << "x raw float32, " << j["keys"] << " keys; error max "
-       << j["error"]["max"].get<double>() << " (" << j["error"]["worst_joint"].get<std::string>() << ", frame "
-       << j["error"]["worst_frame"] << ")";
+       << j["error"]["max"].get<double>() << " (" << j["error"]["worst_point"].get<std::string>() << ", frame "
+       << j["error"]["worst_frame"];
+  if (j["error"].contains("worst_reading")) line << ", " << j["error"]["worst_reading"].get<std::string>() << " reading";
+  line << ")";
   if (j.contains("tolerance")) line << ", tolerance " << j["tolerance"].get<double>();
+  line << ", shell " << j["error"]["shell"].get<double>();
   return printable(line.str());
 }
 

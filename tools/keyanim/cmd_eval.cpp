@@ -23,12 +23,12 @@
 namespace keyanim::cli {
 
 const char* const kEvalHelp =
-    "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--keys MODE[+MODE...]] [--tension T|fit]\n"
-    "                    [--level N] [-j N] [--json] [--svg RD.svg] [--report R.jsonl]\n"
+    "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--shell D|D%] [--keys MODE[+MODE...]]\n"
+    "                    [--tension T|fit] [--level N] [-j N] [--json] [--svg RD.svg] [--report R.jsonl]\n"
     "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
     "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
-    "by zstd -19, the max and RMS world-space error with the worst joint and frame, and the\n"
-    "encode and decode times. Nothing is written.\n"
+    "by zstd -19, the max and RMS world-space error of joints, End Sites and shell points with\n"
+    "the worst point and frame, and the encode and decode times. Nothing is written.\n"
     "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
     "  --svg RD.svg          compression ratio against error, log axes: a line per file, or\n"
     "                        with several key modes a line per mode over every file\n"
@@ -85,7 +85,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
     offline::Motion back;
     if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, path + ": " + error);
     const double decode_ms = ms(td);
-    const offline::ErrorReport e = offline::measure_error(m, back);
+    const offline::ErrorReport e = offline::measure_error(m, back, enc.shell_units);
     const double n = double(bytes.size());
     nlohmann::json result = {{"key_mode", runs[r].keys},
                       {"max_error_percent", size > 0 ? 100.0 * e.max_error / size : 0.0},

@@ -1,5 +1,6 @@
 // keyanim info: what a BVH or .kanim file holds.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <set>
@@ -9,6 +10,7 @@
 #include "escape.h"
 #include "io.h"
 #include "keyanim/offline/fk.h"
+#include "keyanim/offline/notes.h"
 #include "keyanim/version.h"
 #include "report.h"
 
@@ -17,7 +19,9 @@ namespace keyanim::cli {
 const char* const kInfoHelp =
     "usage: keyanim info IN.bvh|IN.kanim [--json]\n"
     "Describes a BVH or .kanim file (recognised by its first bytes): skeleton, frames, frame time,\n"
-    "channels, skeleton size; for .kanim also version, keys per channel, tensions and encoder notes.\n"
+    "channels, skeleton size; for .kanim also version, keys per channel, tensions, encoder notes\n"
+    "and, from them, what the encoder guaranteed: the tolerance, the shell distance, the readings\n"
+    "of position channels, the error reached and its worst point and frame.\n"
     "  --json                one JSON object on standard output\n";
 
 namespace {
@@ -54,6 +58,26 @@ void print_notes(const std::string& notes) {
   std::istringstream lines(notes);
   for (std::string line; std::getline(lines, line);)
     if (!line.empty()) std::cout << "  " << printable(line) << "\n";
+}
+
+// What the encoder notes say was guaranteed (empty for a file without such notes).
+nlohmann::json guarantee_json(const std::string& notes) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const char* key : {"tolerance_units", "shell_units", "max_error"})
+    if (auto v = offline::note_number(notes, key)) j[key] = *v;
+  if (auto r = offline::note(notes, "readings")) {
+    j["readings"] = nlohmann::json::array();
+    for (size_t at = 0; at <= r->size();) {
+      const size_t comma = std::min(r->find(',', at), r->size());
+      j["readings"].push_back(r->substr(at, comma - at));
+      at = comma + 1;
+    }
+  }
+  for (const char* key : {"worst_point", "worst_reading"})
+    if (auto v = offline::note(notes, key)) j[key] = *v;
+  if (auto v = offline::note_number(notes, "worst_frame"); v && *v >= 0.0 && *v <= 4294967295.0 && *v == std::floor(*v))
+    j["worst_frame"] = uint32_t(*v);  // notes come from the file: only a frame number is taken as one
+  return j;
 }
 
 // Names and notes come from the file: printable() keeps their bytes from acting on a terminal.
@@ -131,6 +155,7 @@ int cmd_info(const Argv& argv, Globals& g) {
     j["raw_f32_bytes"] = uint64_t(4) * clip.frame_count() * clip.channel_count();
     j["memory_bytes"] = clip.memory_bytes();
     j["encoder_notes"] = clip.encoder_notes();
+    if (nlohmann::json g = guarantee_json(clip.encoder_notes()); !g.empty()) j["guarantee"] = g;
   }
   if (args.has("--json")) std::cout << json_text(j) << "\n"; else print_text(j);
   return kOk;

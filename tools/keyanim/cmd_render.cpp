@@ -17,7 +17,8 @@ namespace keyanim::cli {
 
 const char* const kRenderHelp =
     "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg]\n"
-    "                      [--error E|E%] [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
+    "                      [--position-channels replace|add] [--error E|E%] [--shell D|D%]\n"
+    "                      [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
     "file length units. Two poses are overlaid and the joint farthest apart is labelled:\n"
     "  - with --against OTHER (BVH or .kanim with the same skeleton): IN and OTHER;\n"
@@ -27,7 +28,10 @@ const char* const kRenderHelp =
     "  --frame N             frame number, 0 .. frames-1 (default: the middle frame)\n"
     "  --against OTHER       a second file to compare with\n"
     "  -o, --output FILE     SVG output (default: IN without extension + -frameN.svg;\n"
-    "                        '-' = standard output)\n";
+    "                        '-' = standard output)\n"
+    "  --position-channels replace|add\n"
+    "                        how position channels below the root combine with OFFSET: replace\n"
+    "                        it (Blender; default) or add to it (three.js)\n";
 
 namespace {
 
@@ -64,7 +68,7 @@ struct Poses {
 }  // namespace
 
 int cmd_render(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "--frame", "--against"};
+  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {});
   if (args.positional().size() != 1) fail(kUsage, "render takes one input file");
@@ -73,6 +77,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   const auto against = args.get("--against");
   if (against && *against == "-" && in == "-") fail(kUsage, "only one input can be standard input");
   const uint32_t frame_option = args.get_uint("--frame", 0);  // parsed before any work
+  const PositionReading reading = position_reading(args);
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
@@ -117,7 +122,7 @@ int cmd_render(const Argv& argv, Globals& g) {
     title += ": original and reconstruction";
   }
 
-  const PoseFigure fig = render_pose(series, 0, title);
+  const PoseFigure fig = render_pose(series, 0, title, reading);
   output.write(fig.svg);
   output.commit();
   if (g.verbosity > 0) {

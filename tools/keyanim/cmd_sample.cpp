@@ -11,20 +11,26 @@
 namespace keyanim::cli {
 
 const char* const kSampleHelp =
-    "usage: keyanim sample IN.kanim (--frame N | --time S) [--joint NAME] [--world] [--json]\n"
+    "usage: keyanim sample IN.kanim (--frame N | --time S) [--joint NAME] [--world]\n"
+    "                      [--position-channels replace|add] [--json]\n"
     "One pose, decoded on the fly (fractional frames and times between frames are in-betweens).\n"
     "  --frame N             frame position, may be fractional (clamped to the clip)\n"
     "  --time S              time in seconds (frame position = S / frame time; clamped)\n"
     "  --joint NAME          only this joint (default: all)\n"
     "  --world               world positions by forward kinematics instead of channel values\n"
+    "  --position-channels replace|add\n"
+    "                        with --world, how position channels below the root combine with\n"
+    "                        OFFSET: replace it (Blender; default) or add to it (three.js)\n"
     "  --json                one JSON object on standard output\n";
 
 int cmd_sample(const Argv& argv, Globals& g) {
-  const Args args(argv, {"--frame", "--time", "--joint"}, {"--world", "--json"});
+  const Args args(argv, {"--frame", "--time", "--joint", "--position-channels"}, {"--world", "--json"});
   if (args.positional().size() != 1) fail(kUsage, "sample takes one .kanim file");
   if (args.has("--frame") == args.has("--time")) fail(kUsage, "sample needs exactly one of --frame and --time");
   const std::string in = args.positional()[0];
   const double frame = args.get_double("--frame", 0.0), time = args.get_double("--time", 0.0);
+  const PositionReading reading = position_reading(args);
+  if (args.has("--position-channels") && !args.has("--world")) fail(kUsage, "--position-channels goes with --world");
   const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g), g);
   // A clip without frames, or without a frame time for --time, cannot give what was asked.
   if (clip.frame_count() == 0) fail(kBadInput, in + ": the clip has no frames to sample");
@@ -42,7 +48,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   }
   std::vector<double> values(row.begin(), row.end());
   std::vector<offline::Vec3> world;
-  if (args.has("--world")) offline::world_positions(sk, values.data(), world);
+  if (args.has("--world")) offline::world_positions(sk, values.data(), world, reading);
 
   nlohmann::json joints = nlohmann::json::array();
   for (uint32_t i = 0; i < sk.joints.size(); ++i) {

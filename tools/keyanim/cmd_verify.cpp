@@ -9,31 +9,50 @@
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
+#include "keyanim/offline/notes.h"
 #include "report.h"
 #include "settings.h"
 
 namespace keyanim::cli {
 
 const char* const kVerifyHelp =
-    "usage: keyanim verify IN.kanim [--against ORIG.bvh [--max-error E|E%]] [--json]\n"
+    "usage: keyanim verify IN.kanim [--against ORIG.bvh [--max-error E|E%] [--shell D|D%]] [--json]\n"
     "Loads and validates every byte of IN (signature, version, sections, checksum). With\n"
-    "--against, decodes it and measures the world-space error of every joint and End Site\n"
-    "against ORIG by forward kinematics; the hierarchy, frame count and frame time must match.\n"
+    "--against, decodes it and measures the world-space error of every joint, End Site and\n"
+    "shell point against ORIG by forward kinematics (under both readings of position channels\n"
+    "below the root, where the file has them); the hierarchy, frame count and frame time must\n"
+    "match.\n"
     "  --against ORIG.bvh    the original to measure the decoded clip against\n"
     "  --max-error E|E%      fail (exit 5) if the error exceeds E file units, or E percent of\n"
     "                        the skeleton size (default: no limit, just report)\n"
+    "  --shell D|D%          shell distance (file units, or percent of the skeleton size; 0:\n"
+    "                        none). Default: the one IN was encoded with (its notes), else 2%\n"
     "  --json                one JSON object on standard output\n"
     "Exit 0 when every check passes, 2 for a damaged file, 3 for an unsupported version,\n"
     "5 when a check fails.\n";
 
+namespace {
+
+// The shell distance in file units: the option, else the clip's notes, else the default.
+double shell_units(const std::optional<offline::EncodeSettings>& option, const Clip& clip, const offline::Motion& orig) {
+  if (option) return option->shell_in_percent ? option->shell / 100.0 * offline::reference_size(orig) : option->shell;
+  const std::optional<double> noted = offline::note_number(clip.encoder_notes(), "shell_units");
+  return noted && *noted >= 0.0 ? *noted : offline::default_shell(orig);
+}
+
+}  // namespace
+
 int cmd_verify(const Argv& argv, Globals& g) {
-  const Args args(argv, {"--against", "--max-error"}, {"--json"});
+  const Args args(argv, {"--against", "--max-error", "--shell"}, {"--json"});
   if (args.positional().size() != 1) fail(kUsage, "verify takes one .kanim file");
-  if (args.has("--max-error") && !args.has("--against")) fail(kUsage, "--max-error needs --against ORIG.bvh");
+  for (const char* o : {"--max-error", "--shell"})
+    if (args.has(o) && !args.has("--against")) fail(kUsage, std::string(o) + " needs --against ORIG.bvh");
   const std::string in = args.positional()[0];
   if (args.get("--against") == "-" && in == "-") fail(kUsage, "only one input can be standard input");
   std::optional<offline::EncodeSettings> limit;  // parsed before any work
   if (auto text = args.get("--max-error")) parse_tolerance(*text, limit.emplace(), "--max-error");
+  std::optional<offline::EncodeSettings> shell;
+  if (auto text = args.get("--shell")) parse_shell(*text, shell.emplace());
   const Clip clip = load_kanim(in, read_input(in, Kind::kanim, g), g);
   nlohmann::json j = {{"file", in}, {"valid", true}};
   bool ok = true;
@@ -51,7 +70,7 @@ int cmd_verify(const Argv& argv, Globals& g) {
       offline::Motion back;
       std::string error;
       if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, in + ": " + error);
-      const offline::ErrorReport e = offline::measure_error(orig, back);
+      const offline::ErrorReport e = offline::measure_error(orig, back, shell_units(shell, clip, orig));
       j["error"] = error_json(orig.skeleton, e);
       if (limit) {
         const offline::EncodeSettings& s = *limit;

@@ -7,6 +7,7 @@
 #include "keyanim/clip.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/fk.h"
+#include "keyanim/offline/metrics.h"
 #include "svg.h"
 
 namespace keyanim::cli {
@@ -31,12 +32,7 @@ std::string short_number(double v) {
 
 }  // namespace
 
-std::string figure_node_name(const Skeleton& s, uint32_t node) {
-  const Joint& j = s.joints[node];
-  if (!j.end_site || !j.name.empty()) return j.name;
-  if (j.parent >= 0 && static_cast<size_t>(j.parent) < s.joints.size()) return "End Site of " + s.joints[j.parent].name;
-  return "End Site";
-}
+std::string figure_node_name(const Skeleton& s, uint32_t node) { return offline::point_name(s, node, 0); }
 
 std::optional<uint32_t> find_channel(const Skeleton& skeleton, const std::string& spec, std::string& error) {
   // The last colon splits: a joint name may contain one, a channel name never does.
@@ -194,7 +190,8 @@ bool same_skeleton(const Skeleton& a, const Skeleton& b) {
   return true;
 }
 
-PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, const std::string& title) {
+PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, const std::string& title,
+                       PositionReading reading) {
   PoseFigure fig;
   std::vector<std::vector<offline::Vec3>> pos(series.size());
   offline::Vec3 lo{}, hi{};
@@ -202,7 +199,7 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
   hi.fill(-std::numeric_limits<double>::infinity());
   for (size_t s = 0; s < series.size(); ++s) {
     const offline::Motion& m = *series[s].motion;
-    offline::world_positions(m.skeleton, m.frame(frame), pos[s]);
+    offline::world_positions(m.skeleton, m.frame(frame), pos[s], reading);
     for (const offline::Vec3& p : pos[s])
       for (int a = 0; a < 3; ++a)
         if (std::isfinite(p[a])) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);

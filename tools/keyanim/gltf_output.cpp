@@ -9,6 +9,7 @@
 #include "escape.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/gltf.h"
+#include "keyanim/offline/metrics.h"
 #include "progress.h"
 #include "report.h"
 #include "settings.h"
@@ -32,12 +33,6 @@ std::string uri_of_file_name(const std::string& name) {
     else o += {'%', kHex[c >> 4], kHex[c & 15]};
   }
   return o;
-}
-
-std::string point_name(const Skeleton& s, const offline::GltfReport& r) {
-  std::string name = node_name(s, r.worst_node);
-  if (r.worst_axis >= 0) name += std::string(" +") + "xyz"[r.worst_axis] + " shell";
-  return name;
 }
 
 }  // namespace
@@ -99,7 +94,7 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
                   "%u CUBICSPLINE, %u keys); error max %.6g (%s, frame %u), tolerance %.6g\n",
                   asset.main.size() + asset.bin.size(), r.nodes, r.translation_tracks, r.translation_keys,
                   r.linear_rotation_tracks + r.cubic_rotation_tracks, r.linear_rotation_tracks, r.cubic_rotation_tracks,
-                  r.rotation_keys, r.max_error, printable(point_name(clip.skeleton(), r)).c_str(), r.worst_frame,
+                  r.rotation_keys, r.max_error, printable(offline::point_name(clip.skeleton(), r.worst_node, uint32_t(r.worst_axis + 1))).c_str(), r.worst_frame,
                   r.tolerance);
     std::cerr << printable(in + " -> " + out) << buf;
   }

@@ -2,30 +2,36 @@
 
 #include <cstdio>
 
+#include "keyanim/offline/metrics.h"
+
 namespace keyanim::cli {
 
-std::string node_name(const Skeleton& s, uint32_t node) {
-  if (node >= s.joints.size()) return "?";
-  const Joint& j = s.joints[node];
-  if (!j.end_site || !j.name.empty()) return j.name;
-  return j.parent >= 0 ? "End Site of " + s.joints[size_t(j.parent)].name : "End Site";
-}
+std::string node_name(const Skeleton& s, uint32_t node) { return offline::point_name(s, node, 0); }
+
+const char* reading_name(PositionReading r) { return r == PositionReading::add ? "add" : "replace"; }
 
 nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e) {
-  return {{"max", e.max_error},
-          {"rms", e.rms_error},
-          {"worst_joint", node_name(s, e.worst_joint)},
-          {"worst_frame", e.worst_frame},
-          {"max_leaf_rotation_deg", e.max_leaf_rotation}};
+  nlohmann::json j = {{"max", e.max_error},
+                      {"rms", e.rms_error},
+                      {"worst_joint", node_name(s, e.worst_joint)},
+                      {"worst_point", offline::point_name(s, e.worst_joint, e.worst_point)},
+                      {"worst_shell_axis", nullptr},
+                      {"worst_frame", e.worst_frame},
+                      {"shell", e.shell},
+                      {"readings", e.both_readings ? nlohmann::json{"replace", "add"} : nlohmann::json{"replace"}}};
+  if (e.worst_point >= 1 && e.worst_point <= 3) j["worst_shell_axis"] = std::string(1, char('x' + e.worst_point - 1));
+  if (e.both_readings) j["worst_reading"] = reading_name(e.worst_reading);
+  return j;
 }
 
 std::string error_text(const Skeleton& s, const offline::ErrorReport& e) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "max %.6g (%s, frame %u), rms %.3g", e.max_error,
-                node_name(s, e.worst_joint).c_str(), e.worst_frame, e.rms_error);
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "max %.6g (%s, frame %u%s), rms %.3g", e.max_error,
+                offline::point_name(s, e.worst_joint, e.worst_point).c_str(), e.worst_frame,
+                !e.both_readings ? "" : e.worst_reading == PositionReading::add ? ", add reading" : ", replace reading",
+                e.rms_error);
   return buf;
 }
-
 std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance_units, double max_error) {
   if (s.key_mode == offline::KeyMode::error || max_error <= tolerance_units) return {};
   const std::string mode = s.key_mode == offline::KeyMode::uniform ? "uniform:" + std::to_string(s.uniform_interval)

@@ -10,8 +10,13 @@ namespace keyanim::cli {
 
 // Display name of a node: its name, or "End Site of PARENT".
 std::string node_name(const Skeleton& s, uint32_t node);
+// "replace" or "add".
+const char* reading_name(PositionReading r);
+// max, rms, worst_joint (the node), worst_point (the node, or "NODE shell x|y|z"),
+// worst_shell_axis (x, y, z or null), worst_frame, shell (distance, file units), readings, and
+// worst_reading when both readings were measured.
 nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e);
-// "max 0.081 (LeftHand, frame 713), rms 0.012"
+// "max 0.081 (LeftHand shell y, frame 713), rms 0.012"
 std::string error_text(const Skeleton& s, const offline::ErrorReport& e);
 
 // Empty, or a warning when --error was given with a key mode that does not apply it (uniform,

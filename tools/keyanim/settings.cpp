@@ -6,10 +6,16 @@ namespace keyanim::cli {
 
 std::string encoder_options_help(bool with_error) {
   const char* const error =
-      "  --error E|E%          tolerance: max world-space joint error, in file length units, or in\n"
-      "                        percent of the skeleton size (largest side of the rest-pose box).\n"
-      "                        Default 0.05%. Range: > 0 (percent: at most 100).\n";
+      "  --error E|E%          tolerance: max world-space error of every joint, End Site and shell\n"
+      "                        point, in file length units, or in percent of the skeleton size\n"
+      "                        (largest side of the rest-pose box). Default 0.05%. Range: > 0\n"
+      "                        (percent: at most 100).\n";
   const char* const others =
+      "  --shell D|D%          shell points: three per joint at distance D along its local x, y\n"
+      "                        and z axes, what a mesh skinned to it sees (file units, or percent\n"
+      "                        of the skeleton size). Default 2%. 0: joints and End Sites only.\n"
+      "                        Files with position channels below the root are kept within\n"
+      "                        --error under both readings of them (replace and add).\n"
       "  --keys MODE           error (default): fewest keys within --error;\n"
       "                        uniform:N every N-th frame (N >= 1); manual:F1,F2,... those frames;\n"
       "                        curvature: curvature feature points. First and last frame always.\n"
@@ -27,6 +33,15 @@ void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const 
   if (s.tolerance_in_percent) t.pop_back();
   s.tolerance = parse_double(option, t);
   if (!(s.tolerance > 0.0)) fail(kUsage, option + " must be positive, got '" + text + "'");
+}
+
+void parse_shell(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
+  std::string t = text;
+  s.shell_in_percent = !t.empty() && t.back() == '%';
+  if (s.shell_in_percent) t.pop_back();
+  s.shell = parse_double(option, t);
+  if (!(s.shell >= 0.0)) fail(kUsage, option + " must be 0 or more, got '" + text + "'");
+  if (s.shell == 0.0) s.shell_in_percent = false;  // "0" and "0%" alike
 }
 
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
@@ -64,6 +79,7 @@ void check_settings_for(const offline::EncodeSettings& s, const offline::Motion&
 offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool read_keys) {
   offline::EncodeSettings s;
   if (auto e = args.get("--error"); e && read_error) parse_tolerance(*e, s);
+  if (auto d = args.get("--shell")) parse_shell(*d, s);
   if (auto k = args.get("--keys"); k && read_keys) parse_key_mode(*k, s);
   if (auto t = args.get("--tension")) {
     if (*t == "fit") {

@@ -1,4 +1,5 @@
-// Encoder options shared by `encode`, `eval` and `plot`: --error, --keys, --tension, --level.
+// Encoder options shared by `encode`, `eval` and `plot`: --error, --shell, --keys, --tension,
+// --level.
 #pragma once
 #include <string>
 
@@ -9,7 +10,7 @@
 namespace keyanim::cli {
 
 // Options that take a value, to declare in Args.
-inline const char* const kEncodeValuedOptions[] = {"--error", "--keys", "--tension", "--level"};
+inline const char* const kEncodeValuedOptions[] = {"--error", "--shell", "--keys", "--tension", "--level"};
 
 // Reads the options (with their documented defaults) and validates them: usage error if wrong.
 // read_error = false leaves --error to the caller (eval takes a list), read_keys = false
@@ -17,6 +18,8 @@ inline const char* const kEncodeValuedOptions[] = {"--error", "--keys", "--tensi
 offline::EncodeSettings encode_settings(const Args& args, bool read_error = true, bool read_keys = true);
 // "0.05%" or "0.1" -> settings.tolerance / tolerance_in_percent; usage error if malformed.
 void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option = "--error");
+// "2%" or "3" or "0" -> settings.shell / shell_in_percent; usage error if malformed or negative.
+void parse_shell(const std::string& text, offline::EncodeSettings& s, const std::string& option = "--shell");
 // "error", "uniform:N", "manual:F1,F2,...", "curvature".
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s);
 

@@ -1,6 +1,7 @@
 // Forward kinematics as spec/FORMAT.md Appendix B: a node's local rotation is the product of
 // its rotation channels in channel order (intrinsic, degrees, right-handed); its translation is
-// its Offset with each position channel replacing its component; p = p_parent + R_parent p_local,
+// its Offset with each position channel replacing its component (reading 'replace', Blender's
+// and the default) or added to it ('add', three.js's); p = p_parent + R_parent p_local,
 // R = R_parent R_local. In binary64. Works on the node lists of kanim.js and bvh.js alike.
 
 const DEG = Math.PI / 180;
@@ -19,9 +20,10 @@ function axisRotation(axis, degrees, out) {
 }
 
 // World positions of every node for one frame: `values` holds every channel (frame column
-// order); `out` gets x, y, z per node. Returns out.
-export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.length)) {
-  const rot = new Float64Array(9 * nodes.length);
+// order); `out` gets x, y, z per node; `rot`, if given, each node's world rotation (9 values,
+// row-major). Returns out.
+export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.length), reading = 'replace',
+                               rot = new Float64Array(9 * nodes.length)) {
   const local = new Float64Array(9), axis = new Float64Array(9), tmp = new Float64Array(9);
   for (let i = 0; i < nodes.length; ++i) {
     const node = nodes[i];
@@ -29,7 +31,7 @@ export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.l
     local.set([1, 0, 0, 0, 1, 0, 0, 0, 1]);
     node.channels.forEach((type, k) => {
       const v = values[node.firstChannel + k];
-      if (type < 3) { t[type] = v; return; }
+      if (type < 3) { t[type] = reading === 'add' ? node.offset[type] + v : v; return; }
       axisRotation(type - 3, v, axis);
       mul(local, axis, tmp);
       local.set(tmp);
@@ -69,4 +71,20 @@ export function largestDistance(a, b) {
     if (d > worst) { worst = d; node = i / 3; }
   }
   return { distance: worst, node };
+}
+
+// The points the encoder's error covers (keyanim/offline/metrics.h), 4 per node: the node, then
+// its shell points at distance `shell` along the columns of its world rotation (for an End Site,
+// or with shell 0, copies of the node).
+export function measuredPoints(nodes, values, shell, reading = 'replace') {
+  const pos = new Float64Array(3 * nodes.length), rot = new Float64Array(9 * nodes.length);
+  worldPositions(nodes, values, pos, reading, rot);
+  const out = new Float64Array(12 * nodes.length);
+  nodes.forEach((node, i) => {
+    for (let k = 0; k < 4; ++k) {
+      const axis = k - 1, on = k > 0 && shell > 0 && !node.endSite;
+      for (let r = 0; r < 3; ++r) out[12 * i + 3 * k + r] = pos[3 * i + r] + (on ? shell * rot[9 * i + 3 * r + axis] : 0);
+    }
+  });
+  return out;
 }

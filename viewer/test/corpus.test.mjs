@@ -11,7 +11,7 @@ import { execFileSync } from 'node:child_process';
 import { decodeKanim, nodeLabel } from '../src/kanim.js';
 import { samplePose } from '../src/sample.js';
 import { parseBvh } from '../src/bvh.js';
-import { worldPositions, skeletonSize, largestDistance } from '../src/pose.js';
+import { worldPositions, measuredPoints, skeletonSize, largestDistance } from '../src/pose.js';
 import { corpusDir, keyanimCli, exists, bvhFilesBelow } from './paths.mjs';
 
 const clips = bvhFilesBelow(corpusDir);
@@ -81,8 +81,9 @@ test('corpus clips: JS decoder = C++ decoder, bit for bit', { skip }, () => {
   assert.equal(checked, clips.length);
 });
 
-// The viewer's comparison (its BVH reader, forward kinematics and largest distance) over every
-// frame of every corpus clip gives the error the encoder measured and wrote in its notes.
+// The viewer's BVH reader and forward kinematics over every frame of every corpus clip, on the
+// points the encoder measures (joints, End Sites and shell points at the distance in its notes,
+// under each reading of position channels it lists), give the error it wrote in its notes.
 test('corpus clips: original against decoded in JS = the encoder\'s max_error', { skip }, () => {
   for (const bvh of clips) {
     const label = path.relative(corpusDir, bvh);
@@ -91,9 +92,14 @@ test('corpus clips: original against decoded in JS = the encoder\'s max_error', 
     assert.equal(original.frameCount, clip.frameCount, label);
     let worst = 0;
     const values = new Float32Array(clip.channelCount), n = original.channelCount;
+    const shell = Number(/^shell_units=(.*)$/m.exec(clip.notes)[1]);
+    const readings = /^readings=(.*)$/m.exec(clip.notes)[1].split(',');
     for (let f = 0; f < clip.frameCount; ++f) {
-      const d = largestDistance(worldPositions(clip.nodes, samplePose(clip, f, values)), worldPositions(original.nodes, original.frames.subarray(f * n, (f + 1) * n)));
-      worst = Math.max(worst, d.distance);
+      for (const reading of readings) {
+        const a = measuredPoints(clip.nodes, samplePose(clip, f, values), shell, reading);
+        const b = measuredPoints(original.nodes, original.frames.subarray(f * n, (f + 1) * n), shell, reading);
+        worst = Math.max(worst, largestDistance(a, b).distance);
+      }
     }
     const reported = Number(/^max_error=(.*)$/m.exec(clip.notes)[1]);  // printed with 6 digits
     assert.ok(Math.abs(worst - reported) <= 1e-5 * reported + 1e-12, `${label}: JS ${worst}, encoder ${reported}`);

@@ -13,7 +13,8 @@ namespace {
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 // Length of a node's local translation: OFFSET, or with its position channels (largest over
-// frames). `stride` is the motion's channel count.
+// frames and over both readings: the channel's value, or OFFSET plus it). `stride` is the
+// motion's channel count.
 double local_translation_length(const Motion& m, const Joint& j, size_t stride) {
   bool has_position = false;
   for (ChannelType t : j.channels) has_position |= !is_rotation(t);
@@ -21,13 +22,19 @@ double local_translation_length(const Motion& m, const Joint& j, size_t stride) 
   double best = 0.0;
   for (uint32_t f = 0; f < m.frame_count; ++f) {
     const double* row = m.values.data() + size_t(f) * stride + j.first_channel;
-    std::array<double, 3> t = j.offset;
-    for (size_t k = 0; k < j.channels.size(); ++k)
-      if (!is_rotation(j.channels[k])) t[size_t(channel_axis(j.channels[k]))] = row[k];
-    best = std::max(best, std::hypot(t[0], t[1], t[2]));
+    std::array<double, 3> replaced = j.offset, added = j.offset;
+    for (size_t k = 0; k < j.channels.size(); ++k) {
+      if (is_rotation(j.channels[k])) continue;
+      const size_t axis = size_t(channel_axis(j.channels[k]));
+      replaced[axis] = row[k], added[axis] = j.offset[axis] + row[k];
+    }
+    best = std::max({best, std::hypot(replaced[0], replaced[1], replaced[2]), std::hypot(added[0], added[1], added[2])});
   }
   return best;
 }
+
+// A rotation that moves no measured point (a leaf joint without a shell) has this budget.
+constexpr double kMaxRotationBudget = 180.0;
 
 // x rounded toward zero to float; never 0 for x > 0 (the budget stays a budget).
 float round_down(double x) noexcept {
@@ -38,11 +45,14 @@ float round_down(double x) noexcept {
 
 }  // namespace
 
-std::vector<double> reach_below(const Motion& m) {
+std::vector<double> reach_below(const Motion& m, double shell) {
   const auto& joints = m.skeleton.joints;
   const size_t stride = m.channel_count();
   std::vector<double> len(joints.size()), down(joints.size(), 0.0);
-  for (size_t i = 0; i < joints.size(); ++i) len[i] = local_translation_length(m, joints[i], stride);
+  for (size_t i = 0; i < joints.size(); ++i) {
+    len[i] = local_translation_length(m, joints[i], stride);
+    if (!joints[i].end_site) down[i] = shell;  // its own shell points
+  }
   for (size_t i = joints.size(); i-- > 0;) {  // children come after parents
     const int32_t p = joints[i].parent;
     if (p >= 0 && size_t(p) < i) down[size_t(p)] = std::max(down[size_t(p)], len[i] + down[i]);
@@ -51,13 +61,14 @@ std::vector<double> reach_below(const Motion& m) {
 }
 
 std::vector<double> base_tolerances(const Motion& m, double tol_units, double shell) {
-  const std::vector<double> down = reach_below(m);
+  const std::vector<double> down = reach_below(m, shell);
   std::vector<double> base(m.channel_count());
   for (size_t j = 0; j < m.skeleton.joints.size(); ++j) {
     const Joint& joint = m.skeleton.joints[j];
+    const double rotation = down[j] > 0.0 ? std::min(kMaxRotationBudget, tol_units / down[j] * kDegPerRad)
+                                          : kMaxRotationBudget;
     for (size_t k = 0; k < joint.channels.size(); ++k)
-      base[joint.first_channel + k] =
-          is_rotation(joint.channels[k]) ? tol_units / std::max(down[j], shell) * kDegPerRad : tol_units;
+      base[joint.first_channel + k] = is_rotation(joint.channels[k]) ? rotation : tol_units;
   }
   return base;
 }
@@ -72,6 +83,7 @@ Budgets::Budgets(const Skeleton& skeleton, std::vector<double> base, uint32_t fr
       words_((size_t(frames) + 63) / 64),
       changed_(base_.size() * words_, 0),
       own_(skeleton.joints.size(), 1.0),
+      own_shell_(skeleton.joints.size(), 1.0),
       below_(skeleton.joints.size(), 1.0) {}
 
 Tolerance Budgets::tolerance(uint32_t c) const noexcept {
@@ -88,7 +100,10 @@ double Budgets::step(uint32_t c, double fraction) const noexcept {
 void Budgets::tighten(uint32_t frame, const std::vector<NodeRatio>& over) {
   const auto& joints = skeleton_->joints;
   const size_t n = joints.size();
-  for (const NodeRatio& o : over) own_[o.node] = std::min(own_[o.node], o.ratio);
+  for (const NodeRatio& o : over) {
+    own_[o.node] = std::min(own_[o.node], o.ratio);
+    if (o.shell) own_shell_[o.node] = std::min(own_shell_[o.node], o.ratio);
+  }
   // Smallest ratio strictly below each node, children before parents.
   for (size_t i = n; i-- > 0;) {
     const int32_t p = joints[i].parent;
@@ -96,8 +111,8 @@ void Budgets::tighten(uint32_t frame, const std::vector<NodeRatio>& over) {
   }
   for (size_t j = 0; j < n; ++j) {
     const Joint& joint = joints[j];
-    const double rotation = below_[j], translation = std::min(own_[j], below_[j]);
-    own_[j] = below_[j] = 1.0;
+    const double rotation = std::min(own_shell_[j], below_[j]), translation = std::min(own_[j], below_[j]);
+    own_[j] = own_shell_[j] = below_[j] = 1.0;
     for (size_t k = 0; k < joint.channels.size(); ++k) {
       const double r = is_rotation(joint.channels[k]) ? rotation : translation;
       if (!(r < 1.0)) continue;

@@ -1,10 +1,11 @@
 // The world-space tolerance turned into per-channel, per-frame budgets through the hierarchy,
 // and tightened where verification finds a node over. Internal to the encoder.
 //
-// A channel's error moves every node below it: a translation moves its own node and the
-// subtree, a rotation the strict descendants. The first budget of a rotation is the angle that
-// moves the farthest point below it by the whole tolerance; of a translation, the tolerance.
-// Where a node is over at a frame, every channel that moves it is tightened at that frame.
+// A channel's error moves every measured point below it (metrics.h): a translation moves its
+// own node's points and the subtree's, a rotation its own node's shell points and the strict
+// descendants'. The first budget of a rotation is the angle that moves the farthest point it
+// moves by the whole tolerance; of a translation, the tolerance. Where a node is over at a
+// frame, every channel that moves the points over is tightened at that frame.
 // Everything here is linear in the number of nodes (a 32,000-joint chain costs 32,000 steps
 // per frame, not 32,000 squared).
 #pragma once
@@ -16,19 +17,22 @@
 
 namespace keyanim::offline {
 
-// For every node, the longest path (sum of local translation lengths, a position channel's
-// largest over the clip in place of its OFFSET component) down to any descendant.
-std::vector<double> reach_below(const Motion& motion);
+// For every node, the longest path (sum of local translation lengths, the largest over the
+// clip and both readings of position channels) from it to a measured point its rotation
+// moves: a descendant, or a shell point `shell` away from a joint at or below it.
+std::vector<double> reach_below(const Motion& motion, double shell);
 
 // Per channel, the first budget: `tol_units` for a translation; for a rotation, the angle in
-// degrees that moves a point at reach_below (at least `shell`) by `tol_units`.
+// degrees that moves a point at reach_below by `tol_units` (at most 180: a rotation that moves
+// no measured point).
 std::vector<double> base_tolerances(const Motion& motion, double tol_units, double shell);
 
 // A node over its budget at some frame, and the factor its movers' budgets are to be
-// multiplied by there (< 1).
+// multiplied by there (< 1). shell: one of its shell points is over (its own rotation moves it).
 struct NodeRatio {
   uint32_t node = 0;
   double ratio = 1.0;
+  bool shell = false;
 };
 
 // Every channel's tolerance at every frame: its base times a per-frame factor. Factors are
@@ -66,8 +70,9 @@ class Budgets {
   std::vector<uint8_t> dirty_;
   size_t words_;                   // 64-bit words per channel in changed_
   std::vector<uint64_t> changed_;  // per channel, a bit per frame
-  // Scratch of tighten(): per node, its own ratio and the smallest ratio strictly below it.
-  std::vector<double> own_, below_;
+  // Scratch of tighten(): per node, its own ratio, that of its shell points, and the smallest
+  // ratio strictly below it.
+  std::vector<double> own_, own_shell_, below_;
 };
 
 }  // namespace keyanim::offline

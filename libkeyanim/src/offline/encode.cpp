@@ -3,8 +3,9 @@
 // verification on exactly what a decoder reproduces (verify.h), all on parallel_for
 // (parallel.h). In error mode the world-space tolerance becomes budgets; each round fits the
 // channels whose budgets changed, verifies the frames whose values changed, and tightens
-// budgets only at the frames and channels where a node is over, until every joint and End Site
-// is within the tolerance. Memory: the motion, each channel's budgets (4 bytes per value) and
+// budgets only at the frames and channels where a node is over, until every measured point
+// (joints, End Sites, shell points; under both readings of position channels where they
+// differ: metrics.h) is within the tolerance. Memory: the motion, each channel's budgets (4 bytes per value) and
 // keys, and windows of frames.
 #include "keyanim/offline/encode.h"
 
@@ -28,12 +29,9 @@
 namespace keyanim::offline {
 namespace {
 
-// Rotation error of a joint with nothing measurable below it is budgeted as if a point sat this
-// far from it (fraction of the skeleton size; ACL uses a 3 cm shell, about 2% of a human).
 // Every channel's first budget is the whole tolerance (budget.h): errors of the channels along
 // a chain rarely peak on the same frame, so this beats any safe split (measured: half of it
 // costs 2-8% more bytes on CMU clips); verification tightens where it is wrong.
-constexpr double kShellFraction = 0.02;
 // Quantization step as a fraction of the channel's smallest per-frame tolerance (a key is then
 // off by at most 0.75 of it). Errors are checked after quantization, so a coarse step costs
 // only a few extra keys; measured on four CMU clips, 1.5 is 2.8% smaller than 1.0 at 0.05% of
@@ -81,6 +79,7 @@ struct Job {
   const Motion& m;
   const EncodeSettings& settings;
   double tol_units;
+  double shell;  // file units
   unsigned threads;
   std::vector<uint32_t> fixed_keys;  // uniform and manual modes
   ChannelLayout layout;
@@ -138,7 +137,7 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
   std::atomic<size_t> done{0};  // as in fit_channels
   parallel_for(windows, job.threads, [&](size_t w, unsigned t) {
     const uint32_t first = uint32_t(w * kVerifyWindow);
-    verify_window(job.m, job.enc.channels, job.enc.tangent_rule, job.tol_units, first,
+    verify_window(job.m, job.enc.channels, job.enc.tangent_rule, job.tol_units, job.shell, first,
                   std::min(kVerifyWindow, frames - first), marks, over[w], scratch[t]);
     const size_t d = ++done;
     if (t == 0) report(job.settings, EncodeStage::verifying, d, windows);
@@ -154,7 +153,7 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
       const uint32_t f = list[i].frame;
       at_frame.clear();
       for (; i < list.size() && list[i].frame == f; ++i)
-        at_frame.push_back({list[i].node, tighten_margin(round) * job.tol_units / list[i].error});
+        at_frame.push_back({list[i].node, tighten_margin(round) * job.tol_units / list[i].error, list[i].shell});
       budgets.tighten(f, at_frame);
       any = true;
     }
@@ -164,9 +163,9 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
 
 // Fits every channel; in error mode, rounds of verification and tightening until every node is
 // within the tolerance. Returns the number of rounds, or 0 with `error` set.
-uint32_t fit_within_tolerance(const Job& job, double size, std::string& error) {
+uint32_t fit_within_tolerance(const Job& job, std::string& error) {
   const Motion& m = job.m;
-  Budgets budgets(m.skeleton, base_tolerances(m, job.tol_units, kShellFraction * size), m.frame_count);
+  Budgets budgets(m.skeleton, base_tolerances(m, job.tol_units, job.shell), m.frame_count);
   std::vector<ChannelFitter> fitters(m.channel_count(), ChannelFitter(fit_options(job.settings)));
   FrameMarks marks(m.frame_count, m.skeleton.joints.size());
   marks.mark_all();
@@ -187,6 +186,8 @@ uint32_t fit_within_tolerance(const Job& job, double size, std::string& error) {
 std::string EncodeSettings::validate() const {
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return "tolerance must be a positive number";
   if (tolerance_in_percent && tolerance > 100.0) return "tolerance in percent must be at most 100";
+  if (!(shell >= 0.0) || !std::isfinite(shell)) return "shell distance must be a number >= 0";
+  if (shell_in_percent && shell > 100.0) return "shell distance in percent must be at most 100";
   if (uniform_interval < 1) return "uniform interval must be at least 1";
   if (!(tension >= -1.0f && tension <= 1.0f)) return "tension must be in [-1, 1]";
   if (zstd_level < 1 || zstd_level > 22) return "zstd level must be in 1..22";
@@ -203,6 +204,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   // Tolerance in file units. A skeleton with no extent (a lone root) falls back to its path.
   const double size = reference_size(m);
   const double tol_units = settings.tolerance_in_percent ? settings.tolerance / 100.0 * size : settings.tolerance;
+  const double shell = settings.shell_in_percent ? settings.shell / 100.0 * size : settings.shell;
   if (!(tol_units > 0.0)) {
     error = "the skeleton has no extent, so a tolerance in percent means nothing: give it in file units";
     return false;
@@ -214,11 +216,11 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   enc.frame_time = m.frame_time;
   enc.tangent_rule = settings.tangent_rule;
   enc.channels.resize(m.channel_count());
-  Job job{m, settings, tol_units, threads, {}, channel_layout(m.skeleton), enc};
+  Job job{m, settings, tol_units, shell, threads, {}, channel_layout(m.skeleton), enc};
   if (settings.key_mode == KeyMode::uniform) job.fixed_keys = uniform_keys(m.frame_count, settings.uniform_interval);
   if (settings.key_mode == KeyMode::manual && !manual_keys(settings.manual_frames, m.frame_count, job.fixed_keys, error))
     return false;
-  const uint32_t rounds = fit_within_tolerance(job, size, error);
+  const uint32_t rounds = fit_within_tolerance(job, error);
   if (rounds == 0) return false;
   release_free_memory();  // the rounds' budgets and fits, before the measurement takes its own
 
@@ -229,13 +231,14 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
     return false;
   }
   report(settings, EncodeStage::measuring, 0, 1);
-  out.error = measure_encoded(m, enc, threads);
+  out.error = measure_encoded(m, enc, shell, threads);
   report(settings, EncodeStage::measuring, 1, 1);
   out.tolerance_units = tol_units;
+  out.shell_units = shell;
   out.iterations = rounds;
   out.total_keys = 0;
   for (const EncodedChannel& ch : enc.channels) out.total_keys += ch.frames.size();
-  enc.notes = encoder_notes(settings, tol_units, out.error, out.iterations);
+  enc.notes = encoder_notes(settings, tol_units, m.skeleton, out.error, out.iterations);
   release_free_memory();  // the measurement's clip, before the caller writes the file
   return true;
 }

@@ -200,7 +200,8 @@ struct TwoRows {
 // its members) are computed.
 template <typename Values, typename D = typename Values::D>
 void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
-                const uint8_t* nodes = nullptr) noexcept {
+                const uint8_t* nodes = nullptr, PositionReading reading = PositionReading::replace) noexcept {
+  const bool add = reading == PositionReading::add;
   const D zero(0.0), one(1.0);
   const std::array<D, 9> identity{one, zero, zero, zero, one, zero, zero, zero, one};
   const size_t n = skeleton.joints.size();
@@ -220,7 +221,8 @@ void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>
         values.sin_cos(column, sn, cs);
         post_rotate(r, channel_axis(type), sn, cs);
       } else {
-        t[static_cast<size_t>(channel_axis(type))] = values.value(column);
+        const size_t axis = static_cast<size_t>(channel_axis(type));
+        t[axis] = add ? D(joint.offset[axis]) + values.value(column) : values.value(column);
       }
     }
     if (root) {
@@ -256,52 +258,63 @@ namespace {
 // per-frame calls allocate nothing after the first.
 template <typename Values>
 void positions_with_scratch(const Skeleton& skeleton, const Values& values, std::vector<Vec3>& out,
-                            const uint8_t* nodes = nullptr) {
+                            const uint8_t* nodes, PositionReading reading) {
   thread_local std::vector<Mat3> rotations;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n);
   out.resize(n);
-  pose_frame(skeleton, values, out.data(), rotations.data(), nodes);
+  pose_frame(skeleton, values, out.data(), rotations.data(), nodes, reading);
 }
 
 }  // namespace
 
-void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, OneRow{frame_row}, out);
+void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out,
+                     PositionReading reading) {
+  positions_with_scratch(skeleton, OneRow{frame_row}, out, nullptr, reading);
 }
 
-void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, OneRow{frame_row}, out, nodes);
+void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out,
+                     PositionReading reading) {
+  positions_with_scratch(skeleton, OneRow{frame_row}, out, nodes, reading);
 }
 
-void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b) {
+void world_pose(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                PositionReading reading, std::vector<Vec3>& pos_a, std::vector<Vec3>& pos_b, std::vector<Mat3>* rot_a,
+                std::vector<Mat3>* rot_b) {
   thread_local std::vector<std::array<Lanes2, 9>> rotations;
   thread_local std::vector<std::array<Lanes2, 3>> positions;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n), positions.resize(n);
-  out_a.resize(n), out_b.resize(n);
-  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes);
+  pos_a.resize(n), pos_b.resize(n);
+  if (rot_a) rot_a->resize(n), rot_b->resize(n);
+  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading);
   for (size_t j = 0; j < n; ++j) {
     if (nodes && !nodes[j]) continue;
-    for (int a = 0; a < 3; ++a) out_a[j][a] = positions[j][a].lane(0), out_b[j][a] = positions[j][a].lane(1);
+    for (int a = 0; a < 3; ++a) pos_a[j][a] = positions[j][a].lane(0), pos_b[j][a] = positions[j][a].lane(1);
+    if (!rot_a) continue;
+    for (int e = 0; e < 9; ++e) (*rot_a)[j][e] = rotations[j][e].lane(0), (*rot_b)[j][e] = rotations[j][e].lane(1);
   }
+}
+
+void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b, PositionReading reading) {
+  world_pose(skeleton, row_a, row_b, nodes, reading, out_a, out_b, nullptr, nullptr);
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,
                      std::vector<Vec3>& out) {
-  positions_with_scratch(skeleton, GivenSinCos{frame_row, sines, cosines}, out);
+  positions_with_scratch(skeleton, GivenSinCos{frame_row, sines, cosines}, out, nullptr, PositionReading::replace);
 }
 
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
-                std::vector<Mat3>& rotations) {
+                std::vector<Mat3>& rotations, PositionReading reading) {
   const size_t n = skeleton.joints.size();
   positions.resize(n);
   rotations.resize(n);
-  pose_frame(skeleton, OneRow{frame_row}, positions.data(), rotations.data());
+  pose_frame(skeleton, OneRow{frame_row}, positions.data(), rotations.data(), nullptr, reading);
 }
 
-std::vector<Vec3> world_positions_all(const Motion& motion) {
+std::vector<Vec3> world_positions_all(const Motion& motion, PositionReading reading) {
   const size_t n = motion.skeleton.joints.size();
   const size_t channels = motion.channel_count();
   const size_t frames = motion.frame_count;
@@ -313,9 +326,20 @@ std::vector<Vec3> world_positions_all(const Motion& motion) {
   std::vector<Vec3> out(frames * n, Vec3{kNaN, kNaN, kNaN});
   std::vector<Mat3> rotations(n);
   for (size_t f = 0; f < complete; ++f) {
-    pose_frame(motion.skeleton, OneRow{motion.values.data() + f * channels}, out.data() + f * n, rotations.data());
+    pose_frame(motion.skeleton, OneRow{motion.values.data() + f * channels}, out.data() + f * n, rotations.data(),
+               nullptr, reading);
   }
   return out;
+}
+
+bool has_position_channels_below_root(const Skeleton& skeleton) noexcept {
+  for (size_t j = 0; j < skeleton.joints.size(); ++j) {
+    const Joint& joint = skeleton.joints[j];
+    if (is_root(joint, j)) continue;
+    for (ChannelType t : joint.channels)
+      if (!is_rotation(t)) return true;
+  }
+  return false;
 }
 
 bool channel_columns_consistent(const Skeleton& skeleton) noexcept {

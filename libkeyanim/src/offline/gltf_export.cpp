@@ -10,6 +10,8 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/gltf.h"
+#include "keyanim/offline/metrics.h"
+#include "keyanim/offline/notes.h"
 
 namespace keyanim::offline {
 namespace {
@@ -23,23 +25,11 @@ constexpr double kMaxWorkingBytes = double(1u << 30);
 constexpr double kMaxResampledKeys = double(1u << 24);
 constexpr double kRoundingMargin = 1e-6;  // of the skeleton size
 
-// The value of `key=` in the encoder notes, or 0.
-double note_value(const std::string& notes, const std::string& key) {
-  std::istringstream in(notes);
-  std::string line;
-  while (std::getline(in, line))
-    if (line.compare(0, key.size() + 1, key + "=") == 0) {
-      const double v = std::strtod(line.c_str() + key.size() + 1, nullptr);
-      return std::isfinite(v) && v > 0.0 ? v : 0.0;
-    }
-  return 0.0;
-}
-
 bool check_options(const Clip& clip, const GltfOptions& o, Window& w, std::string& error) {
   if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) error = "fps must be positive and finite";
   else if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
     error = "tolerance must be positive and finite (at most 100 in percent)";
-  else if (!(o.shell_percent >= 0.0) || !std::isfinite(o.shell_percent)) error = "shell distance must be >= 0";
+  else if (!std::isfinite(o.shell_percent)) error = "shell distance must be finite";
   if (!error.empty()) return false;
   const uint32_t frames = clip.frame_count();
   const bool ranged = o.first_frame != 0 || o.last_frame != UINT32_MAX;
@@ -105,9 +95,16 @@ std::string extras(const GltfReport& r, const Window& w, double fps) {
 // The tolerance in length units: the option, else the clip's own, else the encoder's default.
 double tolerance_units(const Clip& clip, const GltfOptions& o, double size) {
   double tol = o.tolerance_in_percent ? o.tolerance / 100.0 * size : o.tolerance;
-  if (!(tol > 0.0)) tol = note_value(clip.encoder_notes(), "tolerance_units");
+  if (!(tol > 0.0)) tol = note_number(clip.encoder_notes(), "tolerance_units").value_or(0.0);
   if (!(tol > 0.0)) tol = kDefaultTolerancePercent / 100.0 * size;
   return tol;
+}
+
+// The shell distance in length units: the option, else the clip's own, else the default.
+double shell_units(const Clip& clip, const GltfOptions& o, double size) {
+  if (o.shell_percent >= 0.0) return o.shell_percent / 100.0 * size;
+  const double noted = note_number(clip.encoder_notes(), "shell_units").value_or(-1.0);
+  return noted >= 0.0 ? noted : kDefaultShellPercent / 100.0 * size;
 }
 
 // The animation: resampled (--fps) or exact translations and fitted keys; then what a player
@@ -185,7 +182,7 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
   }
   const double size = reference_size(clip);
   report.tolerance = tolerance_units(clip, options, size);
-  report.shell_distance = options.shell_percent / 100.0 * size;
+  report.shell_distance = shell_units(clip, options, size);
   // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result or
   // not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
   if (clip.frame_count() > 0 && options.fps == 0.0 && !(report.tolerance > kRoundingMargin * size)) {

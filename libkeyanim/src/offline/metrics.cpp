@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
 
 namespace keyanim::offline {
@@ -30,34 +31,62 @@ bool usable(const Motion& m) noexcept {
          channel_columns_consistent(m.skeleton);
 }
 
-// Joints whose rotation moves no node: no children, or only End Sites of zero length.
-std::vector<bool> leaf_rotation_joints(const Skeleton& skeleton) {
-  const size_t n = skeleton.joints.size();
-  std::vector<bool> leaf(n, false);
-  for (size_t j = 0; j < n; ++j) leaf[j] = !skeleton.joints[j].end_site;
-  for (size_t j = 0; j < n; ++j) {
-    const Joint& child = skeleton.joints[j];
-    if (child.parent < 0 || static_cast<size_t>(child.parent) >= j) continue;
-    const bool zero_end = child.end_site && child.offset[0] == 0.0 && child.offset[1] == 0.0 &&
-                          child.offset[2] == 0.0;
-    if (!zero_end) leaf[child.parent] = false;
-  }
-  return leaf;
+}  // namespace
+
+std::span<const PositionReading> measured_readings(const Skeleton& skeleton) noexcept {
+  static constexpr PositionReading kBoth[] = {PositionReading::replace, PositionReading::add};
+  return {kBoth, has_position_channels_below_root(skeleton) ? 2u : 1u};
+}
+
+namespace {
+
+// Points of node j from its pose: its position, then position + shell x column `axis` of its
+// world rotation (copies of the position for an End Site or without a shell).
+inline void node_points(const Joint& node, double shell, const Vec3& p, const Mat3& r, Vec3* out) noexcept {
+  out[0] = p;
+  const bool with_shell = shell > 0.0 && !node.end_site;
+  for (int axis = 0; axis < 3; ++axis)
+    out[1 + axis] = with_shell ? Vec3{p[0] + shell * r[axis], p[1] + shell * r[3 + axis], p[2] + shell * r[6 + axis]} : p;
 }
 
 }  // namespace
 
-void measured_points(const Skeleton& skeleton, const double* frame_row, std::vector<std::array<double, 3>>& points,
-                     const uint8_t* nodes) {
-  if (nodes) world_positions(skeleton, frame_row, nodes, points);
-  else world_positions(skeleton, frame_row, points);
+void measured_points(const Skeleton& skeleton, const double* frame_row, double shell, PositionReading reading,
+                     std::vector<std::array<double, 3>>& points) {
+  thread_local std::vector<Vec3> pos;
+  thread_local std::vector<Mat3> rot;
+  world_pose(skeleton, frame_row, pos, rot, reading);
+  const size_t n = skeleton.joints.size();
+  points.resize(n * kPointsPerNode);
+  for (size_t j = 0; j < n; ++j) node_points(skeleton.joints[j], shell, pos[j], rot[j], &points[j * kPointsPerNode]);
 }
 
-void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b,
-                     std::vector<std::array<double, 3>>& points_a, std::vector<std::array<double, 3>>& points_b,
-                     const uint8_t* nodes) {
-  world_positions(skeleton, row_a, row_b, nodes, points_a, points_b);
+void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b, double shell,
+                     PositionReading reading, std::vector<std::array<double, 3>>& points_a,
+                     std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes) {
+  thread_local std::vector<Vec3> pos_a, pos_b;
+  thread_local std::vector<Mat3> rot_a, rot_b;
+  world_pose(skeleton, row_a, row_b, nodes, reading, pos_a, pos_b, &rot_a, &rot_b);
+  const size_t n = skeleton.joints.size();
+  points_a.resize(n * kPointsPerNode), points_b.resize(n * kPointsPerNode);
+  for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
+    node_points(skeleton.joints[j], shell, pos_a[j], rot_a[j], &points_a[j * kPointsPerNode]);
+    node_points(skeleton.joints[j], shell, pos_b[j], rot_b[j], &points_b[j * kPointsPerNode]);
+  }
 }
+
+std::string point_name(const Skeleton& s, uint32_t node, uint32_t point) {
+  if (node >= s.joints.size()) return "?";
+  const Joint& j = s.joints[node];
+  std::string name = j.name;
+  if (j.end_site && j.name.empty())
+    name = j.parent >= 0 && size_t(j.parent) < s.joints.size() ? "End Site of " + s.joints[size_t(j.parent)].name : "End Site";
+  if (point >= 1 && point <= 3) name += std::string(" shell ") + char('x' + point - 1);
+  return name;
+}
+
+double default_shell(const Motion& motion) { return kDefaultShellPercent / 100.0 * reference_size(motion); }
 
 uint32_t measure_window(uint32_t frame_count) {
   const uint32_t windows_of_min = (frame_count + kWindow - 1) / kWindow;
@@ -77,33 +106,44 @@ bool same_pose_rules(const Skeleton& a, const Skeleton& b) {
   return true;
 }
 
-ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, const Skeleton* decoded)
+ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, double shell, const Skeleton* decoded)
     : skeleton_(&skeleton),
       decoded_skeleton_(decoded && !same_pose_rules(skeleton, *decoded) ? decoded : &skeleton),
-      joint_max_(skeleton.joints.size(), 0.0), channel_max_(skeleton.channel_count(), 0.0) {}
+      shell_(shell),
+      joint_max_(skeleton.joints.size(), 0.0),
+      channel_max_(skeleton.channel_count(), 0.0),
+      node_max_(skeleton.joints.size(), 0.0) {}
 
 void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const double* decoded) {
-  if (decoded_skeleton_ == skeleton_) {
-    measured_points(*skeleton_, original, decoded, a_, b_);
-  } else {
-    measured_points(*skeleton_, original, a_);
-    measured_points(*decoded_skeleton_, decoded, b_);
-  }
   const size_t nodes = joint_max_.size();
+  const std::span<const PositionReading> readings = measured_readings(*skeleton_);
+  for (size_t j = 0; j < nodes; ++j) node_max_[j] = 0.0;
+  for (const PositionReading reading : readings) {
+    if (decoded_skeleton_ == skeleton_) {
+      measured_points(*skeleton_, original, decoded, shell_, reading, a_, b_);
+    } else {
+      measured_points(*skeleton_, original, shell_, reading, a_);
+      measured_points(*decoded_skeleton_, decoded, shell_, reading, b_);
+    }
+    for (size_t j = 0; j < nodes; ++j) {
+      const size_t first = j * kPointsPerNode;
+      for (size_t p = first; p < first + measured_point_count(skeleton_->joints[j], shell_); ++p) {
+        const double dx = a_[p][0] - b_[p][0];
+        const double dy = a_[p][1] - b_[p][1];
+        const double dz = a_[p][2] - b_[p][2];
+        const double e = sanitize(std::sqrt(dx * dx + dy * dy + dz * dz));
+        node_max_[j] = std::max(node_max_[j], e);
+        if (!any_ || e > max_error_) {
+          max_error_ = e, worst_joint_ = uint32_t(j), worst_point_ = uint32_t(p - first), worst_frame_ = frame;
+          worst_reading_ = reading;
+          any_ = true;
+        }
+      }
+    }
+  }
   for (size_t j = 0; j < nodes; ++j) {
-    double e = 0.0;
-    for (size_t p = j * kPointsPerNode; p < (j + 1) * kPointsPerNode; ++p) {
-      const double dx = a_[p][0] - b_[p][0];
-      const double dy = a_[p][1] - b_[p][1];
-      const double dz = a_[p][2] - b_[p][2];
-      e = std::max(e, sanitize(std::sqrt(dx * dx + dy * dy + dz * dz)));
-    }
-    sum_sq_ += e * e;
-    if (e > joint_max_[j]) joint_max_[j] = e;
-    if (!any_ || e > max_error_) {
-      max_error_ = e, worst_joint_ = static_cast<uint32_t>(j), worst_frame_ = frame;
-      any_ = true;
-    }
+    sum_sq_ += node_max_[j] * node_max_[j];
+    joint_max_[j] = std::max(joint_max_[j], node_max_[j]);
   }
   for (const Joint& joint : skeleton_->joints) {
     for (size_t k = 0; k < joint.channels.size(); ++k) {
@@ -115,8 +155,10 @@ void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const d
 
 void ErrorAccumulator::merge(const ErrorAccumulator& later) {
   sum_sq_ += later.sum_sq_;
-  if (later.any_ && (!any_ || later.max_error_ > max_error_))
-    max_error_ = later.max_error_, worst_joint_ = later.worst_joint_, worst_frame_ = later.worst_frame_, any_ = true;
+  if (later.any_ && (!any_ || later.max_error_ > max_error_)) {
+    max_error_ = later.max_error_, worst_joint_ = later.worst_joint_, worst_point_ = later.worst_point_;
+    worst_frame_ = later.worst_frame_, worst_reading_ = later.worst_reading_, any_ = true;
+  }
   for (size_t j = 0; j < joint_max_.size(); ++j) joint_max_[j] = std::max(joint_max_[j], later.joint_max_[j]);
   for (size_t c = 0; c < channel_max_.size(); ++c) channel_max_[c] = std::max(channel_max_[c], later.channel_max_[c]);
 }
@@ -125,41 +167,40 @@ ErrorReport ErrorAccumulator::report(uint32_t frames) const {
   ErrorReport r;
   r.max_error = max_error_;
   r.worst_joint = worst_joint_;
+  r.worst_point = worst_point_;
   r.worst_frame = worst_frame_;
+  r.worst_reading = worst_reading_;
+  r.shell = shell_;
+  r.both_readings = measured_readings(*skeleton_).size() == 2;
   r.joint_max = joint_max_;
   r.channel_max = channel_max_;
   const double samples = double(frames) * double(joint_max_.size());
   r.rms_error = samples > 0 ? std::sqrt(sum_sq_ / samples) : 0.0;
-  const std::vector<bool> leaf = leaf_rotation_joints(*skeleton_);
-  for (size_t j = 0; j < leaf.size(); ++j) {
-    if (!leaf[j]) continue;
-    const Joint& joint = skeleton_->joints[j];
-    for (size_t k = 0; k < joint.channels.size(); ++k) {
-      const uint32_t c = joint.first_channel + static_cast<uint32_t>(k);
-      if (is_rotation(joint.channels[k]) && r.channel_max[c] > r.max_leaf_rotation)
-        r.max_leaf_rotation = r.channel_max[c];
-    }
-  }
   return r;
 }
 
 ErrorReport measure_error(const Motion& original, const Motion& decoded) {
+  return measure_error(original, decoded, default_shell(original));
+}
+
+ErrorReport measure_error(const Motion& original, const Motion& decoded, double shell) {
   const size_t nodes = original.skeleton.joints.size();
   const uint32_t channels = original.channel_count();
   const uint32_t frames = original.frame_count;
   if (decoded.channel_count() != channels || decoded.frame_count != frames ||
       decoded.skeleton.joints.size() != nodes || !usable(original) || !usable(decoded)) {
     ErrorReport report;
-    report.max_error = report.rms_error = report.max_leaf_rotation = kInf;
+    report.max_error = report.rms_error = kInf;
+    report.shell = shell;
     report.joint_max.assign(nodes, kInf);
     report.channel_max.assign(channels, kInf);
     return report;
   }
   // Window by window, as a caller measuring in parallel does, so that both agree to the bit.
-  ErrorAccumulator total(original.skeleton, &decoded.skeleton);
+  ErrorAccumulator total(original.skeleton, shell, &decoded.skeleton);
   const uint32_t window = measure_window(frames);
   for (uint32_t first = 0; first < frames; first += window) {
-    ErrorAccumulator part(original.skeleton, &decoded.skeleton);
+    ErrorAccumulator part(original.skeleton, shell, &decoded.skeleton);
     for (uint32_t f = first; f < std::min(frames, first + window); ++f)
       part.add_frame(f, original.values.data() + size_t(f) * channels, decoded.values.data() + size_t(f) * channels);
     total.merge(part);

@@ -1,24 +1,67 @@
 #include "offline/notes.h"
 
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "keyanim/version.h"
 
 namespace keyanim::offline {
 
-std::string encoder_notes(const EncodeSettings& s, double tol_units, const ErrorReport& e, uint32_t rounds) {
+namespace {
+
+// Every digit a double needs to read back the same.
+std::string round_trip(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string encoder_notes(const EncodeSettings& s, double tol_units, const Skeleton& skeleton, const ErrorReport& e,
+                          uint32_t rounds) {
   std::ostringstream o;
   static const char* kModes[] = {"error", "uniform", "manual", "curvature"};
+  const char* reading = e.worst_reading == PositionReading::add ? "add" : "replace";
   o << "encoder=keyanim " << KEYANIM_VERSION_STRING << "\n"
     << "keys=" << kModes[int(s.key_mode)] << "\n"
     << "tolerance=" << s.tolerance << (s.tolerance_in_percent ? "%" : "") << "\n"
     << "tolerance_units=" << tol_units << "\n"
+    << "shell=" << s.shell << (s.shell_in_percent ? "%" : "") << "\n"
+    << "shell_units=" << round_trip(e.shell) << "\n"  // read back to measure as the encoder did
+    << "readings=" << (e.both_readings ? "replace,add" : "replace") << "\n"
     << "tension=" << (s.fit_tension ? std::string("fit") : std::to_string(s.tension)) << "\n"
     << "tangent_rule=" << (s.tangent_rule == TangentRule::step_adjusted ? "step_adjusted" : "uniform") << "\n"
     << "max_error=" << e.max_error << "\n"
     << "rms_error=" << e.rms_error << "\n"
-    << "rounds=" << rounds << "\n";
+    << "worst_point=" << point_name(skeleton, e.worst_joint, e.worst_point) << "\n"
+    << "worst_frame=" << e.worst_frame << "\n";
+  if (e.both_readings) o << "worst_reading=" << reading << "\n";
+  o << "rounds=" << rounds << "\n";
   return o.str();
+}
+
+std::optional<std::string> note(const std::string& notes, std::string_view key) {
+  size_t at = 0;
+  while (at < notes.size()) {
+    const size_t end = std::min(notes.find('\n', at), notes.size());
+    const std::string_view line(notes.data() + at, end - at);
+    if (line.size() > key.size() && line.substr(0, key.size()) == key && line[key.size()] == '=')
+      return std::string(line.substr(key.size() + 1));
+    at = end + 1;
+  }
+  return std::nullopt;
+}
+
+std::optional<double> note_number(const std::string& notes, std::string_view key) {
+  const std::optional<std::string> text = note(notes, key);
+  if (!text) return std::nullopt;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(text->data(), text->data() + text->size(), v);
+  if (ec != std::errc() || end != text->data() + text->size() || !std::isfinite(v)) return std::nullopt;
+  return v;
 }
 
 }  // namespace keyanim::offline

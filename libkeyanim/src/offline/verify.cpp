@@ -95,15 +95,19 @@ void FrameMarks::mark(uint32_t node, uint32_t first, uint32_t last) {
 void FrameMarks::clear_moved() { std::fill(moved_.begin(), moved_.end(), 0); }
 
 void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
-                   uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over, VerifyScratch& w) {
+                   double shell, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
+                   VerifyScratch& w) {
   uint8_t* check = marks.check();
   const auto& joints = m.skeleton.joints;
   const size_t n_ch = channels.size(), nodes = joints.size();
+  const std::span<const PositionReading> readings = measured_readings(m.skeleton);
   w.cursors.resize(n_ch);
   for (size_t c = 0; c < n_ch; ++c) w.cursors[c] = ChannelCursor(channels[c], rule);
   w.row.resize(n_ch);
   w.measure.resize(nodes);
   w.pose.resize(nodes);
+  w.error.resize(nodes);
+  w.shell_over.resize(nodes);
   // The formula of measure_error, so that what passes here passes the final report; the square
   // is compared first against a bound safely inside it (sqrt is correctly rounded).
   const double surely_within = tol * tol * (1.0 - 1e-9);
@@ -116,6 +120,7 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
       const int32_t p = joints[j].parent;
       w.measure[j] = all || marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && w.measure[size_t(p)]);
       w.pose[j] = w.measure[j];
+      w.error[j] = 0.0, w.shell_over[j] = 0;
     }
     for (size_t j = nodes; j-- > 0;) {
       const int32_t p = joints[j].parent;
@@ -128,35 +133,42 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
         w.row[c] = w.cursors[c].at(f);
       }
     }
-    measured_points(m.skeleton, m.values.data() + size_t(f) * n_ch, w.row.data(), w.original, w.decoded, w.pose.data());
+    const double* original = m.values.data() + size_t(f) * n_ch;
+    for (const PositionReading reading : readings) {
+      measured_points(m.skeleton, original, w.row.data(), shell, reading, w.original, w.decoded, w.pose.data());
+      for (size_t d = 0; d < nodes; ++d) {
+        if (!w.measure[d]) continue;
+        const size_t first_point = d * kPointsPerNode;
+        const size_t points = measured_point_count(joints[d], shell);
+        for (size_t p = first_point; p < first_point + points; ++p) {
+          const Vec3& a = w.original[p];
+          const Vec3& b = w.decoded[p];
+          const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+          const double sq = dx * dx + dy * dy + dz * dz;
+          if (sq <= surely_within) continue;
+          const double pe = std::isnan(sq) ? HUGE_VAL : std::sqrt(sq);  // a NaN is over, and stays the worst
+          w.error[d] = std::max(w.error[d], pe);
+          if (p > first_point && pe > tol) w.shell_over[d] = 1;
+        }
+      }
+    }
     bool frame_over = false;
     for (size_t d = 0; d < nodes; ++d) {
-      if (!w.measure[d]) continue;
-      double e = 0.0;
-      for (size_t p = d * kPointsPerNode; p < (d + 1) * kPointsPerNode; ++p) {
-        const Vec3& a = w.original[p];
-        const Vec3& b = w.decoded[p];
-        const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-        const double sq = dx * dx + dy * dy + dz * dz;
-        if (sq <= surely_within) continue;
-        const double pe = std::sqrt(sq);
-        if (!(pe <= e)) e = pe;  // a NaN stays (and is over)
-      }
-      if (e <= tol) continue;
-      over.push_back({f, uint32_t(d), e});
+      if (!w.measure[d] || w.error[d] <= tol) continue;
+      over.push_back({f, uint32_t(d), w.error[d], w.shell_over[d] != 0});
       frame_over = true;
     }
     check[f] = frame_over ? FrameMarks::kOver : 0;
   }
 }
 
-ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, unsigned threads) {
+ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, double shell, unsigned threads) {
   const Clip clip = to_clip(enc);
   const uint32_t frames = m.frame_count, n_ch = m.channel_count();
   const uint32_t window = measure_window(frames);
   const size_t windows = (size_t(frames) + window - 1) / window;
   // The clip's skeleton is the motion's (encode copies it): one skeleton poses both.
-  std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton));
+  std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton, shell));
   parallel_for(windows, threads, [&](size_t w, unsigned) {
     Cursor cursor;
     if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
@@ -169,7 +181,7 @@ ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, unsigned th
       parts[w].add_frame(f, m.values.data() + size_t(f) * n_ch, decoded.data());
     }
   });
-  ErrorAccumulator total(m.skeleton);
+  ErrorAccumulator total(m.skeleton, shell);
   for (const ErrorAccumulator& p : parts) total.merge(p);
   return total.report(frames);
 }

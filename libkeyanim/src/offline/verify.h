@@ -61,6 +61,7 @@ struct OverNode {
   uint32_t frame = 0;
   uint32_t node = 0;
   double error = 0.0;  // file length units: the largest distance among the node's measured points
+  bool shell = false;  // a shell point is over (then the node's own rotation moves it too)
 };
 
 // What to verify, frame by frame, and which nodes may have moved there.
@@ -90,22 +91,25 @@ struct VerifyScratch {
   std::vector<ChannelCursor> cursors;
   std::vector<double> row;
   std::vector<uint8_t> measure, pose;  // per node: its error is measured; it is posed
+  std::vector<double> error;           // per node: the largest distance over the readings
+  std::vector<uint8_t> shell_over;     // per node: a shell point is over
   std::vector<Vec3> original, decoded;
 };
 
 // Verifies the frames f of [first, first + count) marked in `marks`: decodes the channels of
-// the nodes that moved there (and their ancestors), poses original and decoded, and appends to
-// `over` each node whose error exceeds `tolerance` (frame order, then node order) with its
-// error, computed as measure_error does. A frame marked only kChanged measures only the
+// the nodes that moved there (and their ancestors), poses original and decoded (under each of
+// measured_readings), and appends to `over` each node whose error on its measured points
+// (shell distance `shell`) exceeds `tolerance` (frame order, then node order) with its error,
+// computed as measure_error does. A frame marked only kChanged measures only the
 // subtrees of the nodes that moved: the others have not moved since they were last found
 // within the tolerance. Frames with a node over stay marked kOver; the others are unmarked.
 void verify_window(const Motion& original, const std::vector<EncodedChannel>& channels, TangentRule rule,
-                   double tolerance, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
-                   VerifyScratch& scratch);
+                   double tolerance, double shell, uint32_t first, uint32_t count, FrameMarks& marks,
+                   std::vector<OverNode>& over, VerifyScratch& scratch);
 
 // The error report of `clip` (valid: validate_encoded_clip) against `original`, on the clip a
 // decoder loads (to_clip) sampled by Clip::sample at every frame: measure_error's numbers,
-// computed window by window on `threads` threads.
-ErrorReport measure_encoded(const Motion& original, const EncodedClip& clip, unsigned threads);
+// computed window by window on `threads` threads, shell distance `shell`.
+ErrorReport measure_encoded(const Motion& original, const EncodedClip& clip, double shell, unsigned threads);
 
 }  // namespace keyanim::offline

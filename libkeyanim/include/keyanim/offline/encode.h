@@ -1,5 +1,6 @@
 // The codec core: choose key frames per channel, fit tensions, quantize key values, and (in the
-// default mode) guarantee a maximum world-space joint error for what a decoder will produce.
+// default mode) guarantee a maximum world-space error of the measured points (joints, End Sites
+// and the shell points around each joint: metrics.h) for what a decoder will produce.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -13,7 +14,7 @@
 namespace keyanim::offline {
 
 enum class KeyMode : uint8_t {
-  error = 0,      // fewest keys such that every joint and End Site stays within the tolerance
+  error = 0,      // fewest keys such that every measured point (metrics.h) stays within the tolerance
   uniform = 1,    // every N-th frame
   manual = 2,     // the user's frames
   curvature = 3,  // curvature feature points (curvature.h)
@@ -30,6 +31,9 @@ struct EncodeSettings {
   KeyMode key_mode = KeyMode::error;       // Defaults to error-bounded.
   double tolerance = 0.05;                 // Defaults to 0.05 (percent of the skeleton size).
   bool tolerance_in_percent = true;        // Defaults to true; false: file length units.
+  double shell = kDefaultShellPercent;     // Defaults to 2 (percent of the skeleton size): distance of
+                                           // the shell points the error covers (metrics.h); 0: none.
+  bool shell_in_percent = true;            // Defaults to true; false: file length units.
   uint32_t uniform_interval = 10;          // uniform mode: Defaults to every 10th frame (>= 1).
   std::vector<uint32_t> manual_frames;     // manual mode: frame numbers (validated).
   bool fit_tension = false;                // Defaults to false: fixed tension (below).
@@ -72,6 +76,7 @@ struct EncodeResult {
   EncodedClip clip;
   ErrorReport error;          // measured by FK on exactly what a decoder reproduces
   double tolerance_units = 0; // the tolerance in file length units
+  double shell_units = 0;     // the shell distance in file length units (error.shell)
   uint64_t total_keys = 0;
   uint32_t iterations = 0;    // verify-and-tighten rounds (error mode)
 };

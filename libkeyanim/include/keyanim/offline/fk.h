@@ -3,7 +3,8 @@
 // Rules (spec/FORMAT.md states the same): a node's local rotation is the product of its Euler
 // channels in the order its CHANNELS line lists them (intrinsic), R = R_1 * R_2 * R_3, angles in
 // degrees. Its local translation is its OFFSET, except that each position channel it has
-// replaces the matching OFFSET component (as Blender reads BVH). World: p = p_parent +
+// replaces the matching OFFSET component (PositionReading::replace, as Blender reads BVH; the
+// default) or is added to it (PositionReading::add, as three.js does). World: p = p_parent +
 // R_parent_world * t_local, R_world = R_parent_world * R_local. A root (parent -1) starts from
 // the identity at the origin; an End Site has no channels, so its translation is its OFFSET.
 //
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "keyanim/offline/motion.h"
+#include "keyanim/pose.h"
 
 namespace keyanim::offline {
 
@@ -35,31 +37,42 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row);
 // World positions of every node (joints and End Sites) for one frame row of values.
 // `out` is resized to skeleton.joints.size(). Allocates nothing once `out` and a per-thread
 // scratch buffer have reached the skeleton's size.
-void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out);
+void world_positions(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& out,
+                     PositionReading reading = PositionReading::replace);
 
 // The same for the nodes j with nodes[j] != 0 only, a set that must hold every ancestor of
 // its members (positions of the other nodes are left as they were): for callers that know
 // which nodes moved.
-void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out);
+void world_positions(const Skeleton& skeleton, const double* frame_row, const uint8_t* nodes, std::vector<Vec3>& out,
+                     PositionReading reading = PositionReading::replace);
 // Two frames at once (two lanes of SIMD where the machine has them), bit for bit what two
 // calls of the above give; `nodes` may be null (every node).
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b);
+                     std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
+                     PositionReading reading = PositionReading::replace);
+// The same with the world rotations too (null: not wanted), as world_pose gives them.
+void world_pose(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                PositionReading reading, std::vector<Vec3>& pos_a, std::vector<Vec3>& pos_b, std::vector<Mat3>* rot_a,
+                std::vector<Mat3>* rot_b);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values
-// change. Bit-identical to the plain call.
+// change. Bit-identical to the plain call (replace reading).
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines,
                      const double* cosines, std::vector<Vec3>& out);
 // sin and cos of an angle in degrees, exactly as FK computes them.
 void sin_cos_deg(double deg, double& s, double& c) noexcept;
 // World positions and world rotations (R_world of each node; an End Site's is its parent's).
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
-                std::vector<Mat3>& rotations);
+                std::vector<Mat3>& rotations, PositionReading reading = PositionReading::replace);
 
 // World positions for every frame: result[f * node_count + j]. Frames that `values` is too
 // short to hold are filled with NaN.
-std::vector<Vec3> world_positions_all(const Motion& motion);
+std::vector<Vec3> world_positions_all(const Motion& motion, PositionReading reading = PositionReading::replace);
+
+// True when a node other than a root has position channels: then the two readings of them
+// (PositionReading) pose the skeleton differently.
+bool has_position_channels_below_root(const Skeleton& skeleton) noexcept;
 
 // True when every node's channels lie inside a frame row (first_channel + channel count <=
 // channel_count()). FK of a skeleton for which this is false would read past the row.

@@ -41,9 +41,10 @@ struct GltfOptions {
   bool tolerance_in_percent = false;  // Defaults to false.
   // Shell points at this percent of the skeleton size (the size percentages are of: the largest
   // side of the rest-pose box, or of the box a skeleton without extent sweeps, as encode.h's
-  // reference_size).
-  // Defaults to 2 (the project's shell metric); 0 measures joints and End Sites only.
-  double shell_percent = 2.0;
+  // reference_size); 0 measures joints and End Sites only. Defaults to -1 (any negative): the
+  // shell distance the clip was encoded with (its encoder note shell_units), or 2% (the
+  // project's shell metric, metrics.h) when the clip has no such note.
+  double shell_percent = -1.0;
   // Defaults to 0: sparse fitted keys. F > 0: LINEAR keys every 1/F s from the range's start,
   // and one at its end, no fit; the error is measured and reported, not bounded.
   double fps = 0.0;
@@ -86,7 +87,7 @@ struct GltfOutput {
 };
 
 // Builds the asset. Returns false (and says why in `error`, `out` left empty) for options that
-// make no sense (tolerance or fps not positive and finite, shell_percent negative, an empty or
+// make no sense (tolerance or fps not positive and finite, shell_percent not finite, an empty or
 // reversed frame range, last_frame beyond the clip), a clip whose frame time is not positive
 // while it has several frames, a tolerance that float32 keys cannot hold, or a range too long
 // for one asset (working memory above 1 GiB, more than 2^24 resampled keys, 4 GiB of output).
