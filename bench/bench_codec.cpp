@@ -1,6 +1,9 @@
 // Codec benchmark over the corpus: size against error, Cardinal against linear, keyanim against
-// ACL at equal error, encode time against BVH parse time, and, on long clips made from CMU
-// 01_01 (long_clip.h), the speedup of a second thread and the peak memory of an encode.
+// ACL at equal error (../shared/anchors/acl_shell.tsv: the shell metric, interpolated at the
+// error measured under the replace reading, as ACL's was; per file the ratio, per group of
+// clips the median and worst: acl_groups), encode time against BVH parse time, and, on long
+// clips made from CMU 01_01 (long_clip.h), the speedup of a second thread and the peak memory
+// of an encode.
 // Prints one JSON object; the targets are the top-level fields
 //   encode_over_parse_1thread  median over the CMU 120 fps files of (encode + write) / parse,
 //                              one thread, CPU time of the thread (the machine may be shared)
@@ -35,6 +38,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/metrics.h"
+#include "acl_compare.h"
 #include "long_clip.h"
 
 namespace fs = std::filesystem;
@@ -65,47 +69,11 @@ std::string read_file(const fs::path& p) {
   return text;
 }
 
-struct AclRow {
-  double threshold, bytes, max_err;
-};
-
-// acl.tsv: file, frames, fps, acl_threshold, acl_bytes, acl_max_err, ...
-std::map<std::string, std::vector<AclRow>> read_acl(const fs::path& path) {
-  std::map<std::string, std::vector<AclRow>> out;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string file, frames, fps, thr, bytes, err;
-    std::getline(s, file, '\t'), std::getline(s, frames, '\t'), std::getline(s, fps, '\t');
-    std::getline(s, thr, '\t'), std::getline(s, bytes, '\t'), std::getline(s, err, '\t');
-    out[file].push_back({std::stod(thr), std::stod(bytes), std::stod(err)});
-  }
-  for (auto& [k, v] : out) std::sort(v.begin(), v.end(), [](auto& a, auto& b) { return a.max_err < b.max_err; });
-  return out;
-}
-
-// ACL's size at error e, interpolated log-log between the rows that bracket e (anchors README);
-// outside the measured range: the nearest row (a bound, flagged).
-nlohmann::json acl_at(const std::vector<AclRow>& rows, double e) {
-  if (rows.empty()) return nullptr;
-  if (e <= rows.front().max_err) return {{"bytes", rows.front().bytes}, {"interpolated", false}, {"note", "below ACL's smallest measured error"}};
-  if (e >= rows.back().max_err) return {{"bytes", rows.back().bytes}, {"interpolated", false}, {"note", "above ACL's largest measured error"}};
-  for (size_t i = 0; i + 1 < rows.size(); ++i) {
-    const AclRow& a = rows[i];
-    const AclRow& b = rows[i + 1];
-    if (e < a.max_err || e > b.max_err) continue;
-    const double t = std::log(e / a.max_err) / std::log(b.max_err / a.max_err);
-    return {{"bytes", std::exp(std::log(a.bytes) + t * std::log(b.bytes / a.bytes))}, {"interpolated", true}};
-  }
-  return nullptr;
-}
-
 struct RunResult {
   size_t bytes = 0;
   uint64_t keys = 0;
-  double max_error = 0, rms_error = 0, tolerance = 0, encode_ms = 0;
+  double max_error = 0, max_error_replace = 0, rms_error = 0, tolerance = 0, encode_ms = 0;
+  std::string worst_point;
   bool ok = false;
   std::string error;
 };
@@ -129,6 +97,8 @@ RunResult run(const offline::Motion& m, offline::EncodeSettings s) {
   if (!offline::decode_motion(clip, {}, decoded, r.error)) return r;
   const offline::ErrorReport e = offline::measure_error(m, decoded);
   r.bytes = bytes.size(), r.keys = enc.total_keys, r.max_error = e.max_error, r.rms_error = e.rms_error;
+  r.max_error_replace = e.reading_max[size_t(PositionReading::replace)];
+  r.worst_point = offline::point_name(m.skeleton, e.worst_joint, e.worst_point);
   r.tolerance = enc.tolerance_units;
   r.ok = true;
   return r;
@@ -270,7 +240,10 @@ int main(int argc, char** argv) {
     std::cerr << "bench_codec: corpus not found at " << corpus << "\n";
     return 1;
   }
-  const auto acl = read_acl(corpus.parent_path() / "anchors" / "acl.tsv");
+  std::string acl_error;
+  const auto acl = cli::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
+  if (!acl_error.empty()) std::cerr << "bench_codec: " << acl_error << " (no comparison with ACL)\n";
+  std::map<std::string, std::vector<cli::RatioEntry>> ratios;  // tolerance -> per file
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(corpus))
     if (e.path().extension() == ".bvh" && e.path().string().find(filter) != std::string::npos) files.push_back(e.path());
@@ -301,6 +274,7 @@ int main(int argc, char** argv) {
                         {"group", p.parent_path().filename().string()},
                         {"cmu_120fps", cmu120},
                         {"frames", m.frame_count},
+                        {"seconds", m.frame_count * m.frame_time},
                         {"channels", m.channel_count()},
                         {"raw_f32_bytes", raw},
                         {"bvh_bytes", text.size()},
@@ -323,15 +297,22 @@ int main(int argc, char** argv) {
                 {"keys", c.keys},
                 {"ratio_raw_f32", raw / double(c.bytes)},
                 {"max_error", c.max_error},
+                {"max_error_replace", c.max_error_replace},
+                {"worst_point", c.worst_point},
+                {"bytes_per_second", m.frame_count * m.frame_time > 0 ? nlohmann::json(double(c.bytes) / (m.frame_count * m.frame_time))
+                                                                      : nlohmann::json(nullptr)},
                 {"rms_error", c.rms_error},
                 {"within_tolerance", c.max_error <= c.tolerance},
                 {"encode_ms", c.encode_ms},
                 {"encode_over_parse", c.encode_ms / parse_ms[1]}});
       const auto it = acl.find(p.filename().string());
-      if (it != acl.end()) {
-        nlohmann::json a = acl_at(it->second, c.max_error);
+      if (it != acl.end() && !it->second.rows.empty()) {
+        nlohmann::json a = cli::acl_at(it->second, c.max_error_replace);
+        a["ratio"] = double(c.bytes) / a["bytes"].get<double>();
+        a["group"] = cli::comparison_group(it->second);
         r["acl_at_equal_error"] = a;
-        if (a.is_object()) r["smaller_than_acl"] = double(c.bytes) < a["bytes"].get<double>();
+        r["smaller_than_acl"] = double(c.bytes) < a["bytes"].get<double>();
+        ratios[tol].push_back({a["group"].get<std::string>(), p.filename().string(), a["ratio"].get<double>()});
       }
       if (linear) {
         offline::EncodeSettings ls = s;
@@ -365,6 +346,9 @@ int main(int argc, char** argv) {
                     {"max_encode_over_parse", t["max_encode_over_parse"]}};
   }
   out["summary_cmu_120fps"] = summary;
+  nlohmann::json groups = nlohmann::json::object();
+  for (const auto& [tol, entries] : ratios) groups[tol] = cli::group_summary(entries);
+  out["acl_groups"] = groups;  // per tolerance, per group: files, median_ratio, worst_ratio, worst_file
   out["encode_over_parse_1thread"] = summary.contains(tolerances[0]) ? summary[tolerances[0]]["median_encode_over_parse"] : nlohmann::json(nullptr);
   out["encode_over_parse_tolerance"] = tolerances[0];
   if (long_runs) {

@@ -4,6 +4,9 @@
 #         with one point per tolerance, log axes labelled with their units;
 # report: the JSON lines match eval --json, and each total's bytes per second is the files'
 #         bytes over their frames x frame time, recomputed here.
+# acl:    --acl TABLE: ACL's bytes at each file's error interpolated log-log between the rows
+#         that bracket it (the nearest row outside them), the ratio, and per group the median
+#         and worst ratio, all recomputed here from a table written here.
 set -uo pipefail
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 mkdir lib && cp "$WALK" "$HOP" lib/
@@ -68,6 +71,54 @@ for t in totals:
     assert abs(t["ratio_raw_f32"] - sum(l["raw_f32_bytes"] for l in mine) / bytes_) < 1e-12, t
     assert t["max_error_percent"] == max(l["max_error_percent"] for l in mine), t
 PY
+  ;;
+acl)
+  # Walk: three rows around any error it can reach (an unsorted table, one row at error 0 left
+  # out); hop: two rows above its errors (nearest row); a file of size 0 has no usable row.
+  printf 'file\tgroup\tframes\tfps\tsize\tacl_bytes\tacl_err_units\n' >t.tsv
+  printf 'cmu_02_01_walk.bvh\tcmu\t344\t120\t24\t30000\t0.001\n' >>t.tsv
+  printf 'cmu_02_01_walk.bvh\tcmu\t344\t120\t24\t9000\t1\n' >>t.tsv
+  printf 'cmu_02_01_walk.bvh\tcmu\t344\t120\t24\t16000\t0.05\n' >>t.tsv
+  printf 'cmu_02_01_walk.bvh\tcmu\t344\t120\t24\t99\t0\n' >>t.tsv
+  printf 'cmu_131_03_hop.bvh\tbandai\t1102\t30\t24\t50000\t5\n' >>t.tsv
+  printf 'cmu_131_03_hop.bvh\tbandai\t1102\t30\t24\t40000\t10\n' >>t.tsv
+  printf 'other.bvh\tmisc\t10\t30\t0\t500\t0.1\n' >>t.tsv
+  "$K" eval lib --error 0.05%,0.5% --acl t.tsv --json >acl.json || die "eval --acl --json"
+  "$K" eval lib --error 0.05%,0.5% --acl t.tsv >acl.txt || die "eval --acl"
+  python3 - <<'PY' || die "the comparison with ACL"
+import json, math
+doc = json.load(open("acl.json"))
+rows = {"cmu_02_01_walk.bvh": [(0.001, 30000), (0.05, 16000), (1, 9000)], "cmu_131_03_hop.bvh": [(5, 50000), (10, 40000)]}
+groups = {"cmu_02_01_walk.bvh": "cmu_120fps", "cmu_131_03_hop.bvh": "bandai_30fps"}
+ratios = {}
+for f in doc["files"]:
+    name = f["file"].split("/")[-1]
+    for r in f["results"]:
+        e, a = r["error"]["max"], r["acl"]
+        assert a["error"] == e and a["group"] == groups[name], a
+        pts = rows[name]
+        if e <= pts[0][0]: want, interp = pts[0][1], False
+        elif e >= pts[-1][0]: want, interp = pts[-1][1], False
+        else:
+            (e0, b0), (e1, b1) = [(p, q) for p, q in zip(pts, pts[1:]) if p[0] <= e <= q[0]][0]
+            want, interp = math.exp(math.log(b0) + math.log(e / e0) / math.log(e1 / e0) * math.log(b1 / b0)), True
+        assert abs(a["bytes"] - want) <= 1e-9 * want and a["interpolated"] == interp, (name, e, a, want)
+        assert abs(a["ratio"] - r["kanim_bytes"] / want) <= 1e-12, a
+        assert abs(r["bytes_per_second"] - r["kanim_bytes"] / (f["frames"] * f["frame_time"])) <= 1e-9 * r["bytes_per_second"]
+        ratios.setdefault(r["tolerance"], {})[name] = a["ratio"]
+    assert groups[name] == "bandai_30fps" or all(r["acl"]["interpolated"] for r in f["results"]), name
+for tol, by_file in ratios.items():
+    summary = doc["acl_summary"]["error " + tol]
+    assert sorted(summary) == ["bandai_30fps", "cmu_120fps"], summary
+    for name, ratio in by_file.items():
+        g = summary[groups[name]]
+        assert g["files"] == 1 and g["median_ratio"] == ratio and g["worst_ratio"] == ratio and g["worst_file"].endswith(name), g
+text = open("acl.txt").read()
+assert "x ACL" in text and "against ACL, error 0.05%, cmu_120fps: 1 files, median" in text, text
+PY
+  expect_rc 2 "$K" eval lib --acl missing.tsv
+  printf 'a\tb\n1\t2\n' >bad.tsv
+  expect_rc 2 "$K" eval lib --acl bad.tsv
   ;;
 *) die "unknown case $CASE" ;;
 esac

@@ -600,6 +600,9 @@ TEST_CASE("metrics position channels below the root are measured under both read
   CHECK(r.worst_reading == keyanim::PositionReading::add);
   CHECK(r.worst_joint == 2);
   CHECK(r.max_error == doctest::Approx(2 * std::sqrt(109.0) * std::sin(deg)).epsilon(1e-12));
+  CHECK(r.reading_max[size_t(keyanim::PositionReading::add)] == r.max_error);
+  CHECK(r.reading_max[size_t(keyanim::PositionReading::replace)] ==
+        doctest::Approx(2 * std::sqrt(34.0) * std::sin(deg)).epsilon(1e-12));
   CHECK(r.joint_max[1] == doctest::Approx(2 * 10 * std::sin(deg)).epsilon(1e-12));
   // FK itself under each reading.
   std::vector<Vec3> replaced, added;

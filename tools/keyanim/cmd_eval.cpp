@@ -3,11 +3,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <map>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <sstream>
 
+#include "acl_compare.h"
 #include "batch.h"
 #include "eval_report.h"
 #include "commands.h"
@@ -25,6 +28,7 @@ namespace keyanim::cli {
 const char* const kEvalHelp =
     "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--shell D|D%] [--keys MODE[+MODE...]]\n"
     "                    [--tension T|fit] [--level N] [-j N] [--json] [--svg RD.svg] [--report R.jsonl]\n"
+    "                    [--acl TABLE.tsv]\n"
     "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
     "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
     "by zstd -19, the max and RMS world-space error of joints, End Sites and shell points with\n"
@@ -34,6 +38,12 @@ const char* const kEvalHelp =
     "                        with several key modes a line per mode over every file\n"
     "  --report R.jsonl      the figures as JSON lines, one per file and setting, then a total\n"
     "                        per setting with the bytes per second of motion over every file\n"
+    "  --acl TABLE.tsv       compare with ACL at equal error: ACL's bytes and error measured on\n"
+    "                        the same files under the shell metric (e.g. the project's\n"
+    "                        ../shared/anchors/acl_shell.tsv), interpolated log-log at the error\n"
+    "                        reached (under the replace reading, as ACL was measured); per file\n"
+    "                        the ratio of bytes, per group (CMU 120 fps, Bandai 30 fps, other)\n"
+    "                        the median and worst ratio\n"
     "  -j N                  threads (default: one per core)\n"
     "  --json                one JSON object on standard output\n"
     "--keys takes several modes joined by + (error+uniform:10+curvature): every one is run at\n"
@@ -52,7 +62,21 @@ size_t zstd19_size(const std::vector<uint8_t>& text) {
   return ZSTD_isError(n) ? 0 : n;
 }
 
-nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& runs, const Globals& g) {
+// ACL at this file's error, from the table (nothing when the table has no such file).
+void compare_with_acl(const std::map<std::string, AclFile>& acl, const std::string& path, const offline::ErrorReport& e,
+                      double bytes, nlohmann::json& result) {
+  const auto it = acl.find(std::filesystem::path(path).filename().string());
+  if (it == acl.end() || it->second.rows.empty()) return;
+  const double error = e.reading_max[size_t(PositionReading::replace)];
+  nlohmann::json a = acl_at(it->second, error);
+  a["error"] = error;
+  a["group"] = comparison_group(it->second);
+  a["ratio"] = bytes / a["bytes"].get<double>();
+  result["acl"] = a;
+}
+
+nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& runs,
+                         const std::map<std::string, AclFile>& acl, const Globals& g) {
   const std::vector<uint8_t> text = read_input(path, Kind::bvh, g);
   const auto t0 = Clock::now();
   const offline::Motion m = load_bvh_bytes(path, text, g);
@@ -87,7 +111,9 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
     const double decode_ms = ms(td);
     const offline::ErrorReport e = offline::measure_error(m, back, enc.shell_units);
     const double n = double(bytes.size());
+    const double seconds = m.frame_count * m.frame_time;
     nlohmann::json result = {{"key_mode", runs[r].keys},
+                      {"bytes_per_second", seconds > 0 ? nlohmann::json(n / seconds) : nlohmann::json(nullptr)},
                       {"max_error_percent", size > 0 ? 100.0 * e.max_error / size : 0.0},
                       {"keys", enc.total_keys},
                       {"kanim_bytes", bytes.size()},
@@ -107,21 +133,62 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
       result["error_limit_met"] = e.max_error <= enc.tolerance_units;
       result["warning"] = tolerance_warning(settings, enc.tolerance_units, e.max_error);
     }
+    compare_with_acl(acl, path, e, n, result);
     file["results"].push_back(std::move(result));
   }
   return file;
 }
 
+// Per setting (key mode and tolerance), per group: the median and worst ratio against ACL.
+nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
+  std::map<std::string, std::vector<RatioEntry>> runs;
+  for (const auto& f : files) {
+    if (f.is_null()) continue;
+    for (const auto& r : f["results"]) {
+      if (!r.contains("acl")) continue;
+      const std::string run = r["key_mode"].get<std::string>() + " " +
+                              r[r.contains("tolerance") ? "tolerance" : "error_limit"].get<std::string>();
+      runs[run].push_back({r["acl"]["group"].get<std::string>(), f["file"].get<std::string>(),
+                           r["acl"]["ratio"].get<double>()});
+    }
+  }
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [run, entries] : runs) out[run] = group_summary(entries);
+  return out;
+}
+
+// " ACL bytes  x ACL" of a result, or nothing without a comparison.
+std::string acl_columns(const nlohmann::json& r) {
+  if (!r.contains("acl")) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " %10.0f %7.3f", r["acl"]["bytes"].get<double>(), r["acl"]["ratio"].get<double>());
+  return buf;
+}
+
+void print_acl_summary(const nlohmann::json& summary) {
+  for (const auto& [run, groups] : summary.items())
+    for (const auto& [group, g] : groups.items())
+      std::printf("against ACL, %s, %s: %zu files, median %.3f, worst %.3f (%s)\n", run.c_str(), group.c_str(),
+                  g["files"].get<size_t>(), g["median_ratio"].get<double>(), g["worst_ratio"].get<double>(),
+                  printable(g["worst_file"].get<std::string>()).c_str());
+}
+
 }  // namespace
 
 int cmd_eval(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-j", "--svg", "--report"};
+  std::set<std::string> valued{"-j", "--svg", "--report", "--acl"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {"--json"});
   if (args.positional().empty()) fail(kUsage, "eval needs at least one BVH file or directory");
   if (std::count(args.positional().begin(), args.positional().end(), "-") > 1)
     fail(kUsage, "only one input can be standard input");
   const std::vector<EvalRun> runs = eval_runs(args);
+  std::map<std::string, AclFile> acl;
+  if (auto table = args.get("--acl")) {
+    std::string why;
+    acl = read_acl_table(*table, why);
+    if (!why.empty()) fail(kBadInput, why);
+  }
   const std::vector<std::string> files = expand_inputs(args.positional());
   if (files.empty()) fail(kBadInput, "no .bvh files found");
   // The figure and the report are checked (and their temporary files opened) before the work.
@@ -135,7 +202,7 @@ int cmd_eval(const Argv& argv, Globals& g) {
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
   const int code = run_batch(files.size(), thread_count(args), g,
-                             [&](size_t i) { results[i] = eval_file(files[i], runs, quiet); }, files);
+                             [&](size_t i) { results[i] = eval_file(files[i], runs, acl, quiet); }, files);
 
   // Warnings only when --error was given: the default list is not a request.
   for (auto& f : results) {
@@ -150,31 +217,37 @@ int cmd_eval(const Argv& argv, Globals& g) {
   }
   if (svg) svg->write(eval_svg(results)), svg->commit();
   if (report) report->write(eval_jsonl(results)), report->commit();
+  const nlohmann::json summary = acl_summary(results);
   if (args.has("--json")) {
     nlohmann::json all = nlohmann::json::array();
     for (const auto& r : results)
       if (!r.is_null()) all.push_back(r);
-    std::cout << json_text({{"files", all}}) << "\n";
+    nlohmann::json out = {{"files", all}};
+    if (args.has("--acl")) out["acl_summary"] = summary;
+    std::cout << json_text(out) << "\n";
     return code;
   }
   const bool applied = runs.front().settings.key_mode == offline::KeyMode::error;  // else --error is not a tolerance
   const bool modes = runs.front().keys != runs.back().keys;  // several key modes: say which
-  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s\n", "file", applied ? "tolerance" : "--error", "keys",
-              "bytes", "x raw", "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms");
+  const bool with_acl = args.has("--acl");
+  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s%s\n", "file", applied ? "tolerance" : "--error", "keys",
+              "bytes", "x raw", "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms",
+              with_acl ? "  ACL bytes   x ACL" : "");
   for (const auto& f : results) {
     if (f.is_null()) continue;
     std::string name = printable(f["file"].get<std::string>());
     if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
     for (const auto& r : f["results"])
-      std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f\n", name.c_str(),
+      std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f%s\n", name.c_str(),
                   printable((modes ? r["key_mode"].get<std::string>() + " " : std::string()) +
                             r[r.contains("tolerance") ? "tolerance" : "error_limit"].get<std::string>())
                       .c_str(),
                   r["keys"].get<unsigned long long>(), r["kanim_bytes"].get<unsigned long long>(),
                   r["ratio_raw_f32"].get<double>(), r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(),
                   r["error"]["max"].get<double>(), r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(),
-                  r["decode_ms"].get<double>());
+                  r["decode_ms"].get<double>(), acl_columns(r).c_str());
   }
+  if (with_acl) print_acl_summary(summary);
   return code;
 }
 

@@ -155,7 +155,7 @@ int cmd_info(const Argv& argv, Globals& g) {
     j["raw_f32_bytes"] = uint64_t(4) * clip.frame_count() * clip.channel_count();
     j["memory_bytes"] = clip.memory_bytes();
     j["encoder_notes"] = clip.encoder_notes();
-    if (nlohmann::json g = guarantee_json(clip.encoder_notes()); !g.empty()) j["guarantee"] = g;
+    if (nlohmann::json noted = guarantee_json(clip.encoder_notes()); !noted.empty()) j["guarantee"] = noted;
   }
   if (args.has("--json")) std::cout << json_text(j) << "\n"; else print_text(j);
   return kOk;

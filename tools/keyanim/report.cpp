@@ -20,7 +20,11 @@ nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e) {
                       {"shell", e.shell},
                       {"readings", e.both_readings ? nlohmann::json{"replace", "add"} : nlohmann::json{"replace"}}};
   if (e.worst_point >= 1 && e.worst_point <= 3) j["worst_shell_axis"] = std::string(1, char('x' + e.worst_point - 1));
-  if (e.both_readings) j["worst_reading"] = reading_name(e.worst_reading);
+  if (e.both_readings) {
+    j["worst_reading"] = reading_name(e.worst_reading);
+    j["max_by_reading"] = {{"replace", e.reading_max[size_t(PositionReading::replace)]},
+                           {"add", e.reading_max[size_t(PositionReading::add)]}};
+  }
   return j;
 }
 

@@ -133,6 +133,8 @@ void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const d
         const double dz = a_[p][2] - b_[p][2];
         const double e = sanitize(std::sqrt(dx * dx + dy * dy + dz * dz));
         node_max_[j] = std::max(node_max_[j], e);
+        double& by_reading = reading_max_[size_t(reading)];
+        by_reading = std::max(by_reading, e);
         if (!any_ || e > max_error_) {
           max_error_ = e, worst_joint_ = uint32_t(j), worst_point_ = uint32_t(p - first), worst_frame_ = frame;
           worst_reading_ = reading;
@@ -159,6 +161,7 @@ void ErrorAccumulator::merge(const ErrorAccumulator& later) {
     max_error_ = later.max_error_, worst_joint_ = later.worst_joint_, worst_point_ = later.worst_point_;
     worst_frame_ = later.worst_frame_, worst_reading_ = later.worst_reading_, any_ = true;
   }
+  for (size_t r = 0; r < 2; ++r) reading_max_[r] = std::max(reading_max_[r], later.reading_max_[r]);
   for (size_t j = 0; j < joint_max_.size(); ++j) joint_max_[j] = std::max(joint_max_[j], later.joint_max_[j]);
   for (size_t c = 0; c < channel_max_.size(); ++c) channel_max_[c] = std::max(channel_max_[c], later.channel_max_[c]);
 }
@@ -172,6 +175,7 @@ ErrorReport ErrorAccumulator::report(uint32_t frames) const {
   r.worst_reading = worst_reading_;
   r.shell = shell_;
   r.both_readings = measured_readings(*skeleton_).size() == 2;
+  r.reading_max = reading_max_;
   r.joint_max = joint_max_;
   r.channel_max = channel_max_;
   const double samples = double(frames) * double(joint_max_.size());
@@ -191,6 +195,7 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded, double 
       decoded.skeleton.joints.size() != nodes || !usable(original) || !usable(decoded)) {
     ErrorReport report;
     report.max_error = report.rms_error = kInf;
+    report.reading_max = {kInf, kInf};
     report.shell = shell;
     report.joint_max.assign(nodes, kInf);
     report.channel_max.assign(channels, kInf);

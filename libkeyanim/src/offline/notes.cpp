@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "keyanim/version.h"
@@ -11,11 +10,11 @@ namespace keyanim::offline {
 
 namespace {
 
-// Every digit a double needs to read back the same.
+// The shortest text that reads back as the same double.
 std::string round_trip(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
 }
 
 }  // namespace

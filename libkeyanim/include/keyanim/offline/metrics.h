@@ -34,6 +34,9 @@ struct ErrorReport {
   PositionReading worst_reading = PositionReading::replace;
   double shell = 0.0;           // the shell distance measured with, file units (0: no shell)
   bool both_readings = false;   // measured under replace and add (measured_readings)
+  // The largest error under each reading, indexed by PositionReading (add: 0 unless measured).
+  // ACL and Blender read position channels as replace: compare with them on that one.
+  std::array<double, 2> reading_max{};
   std::vector<double> joint_max;    // per node, over its points and the readings
   std::vector<double> channel_max;  // per channel: length units, or degrees (compared modulo 360)
 };
@@ -89,6 +92,7 @@ class ErrorAccumulator {
   double max_error_ = 0.0;
   uint32_t worst_joint_ = 0, worst_point_ = 0, worst_frame_ = 0;
   PositionReading worst_reading_ = PositionReading::replace;
+  std::array<double, 2> reading_max_{};
   std::vector<double> joint_max_, channel_max_;
   std::vector<double> node_max_;  // scratch of add_frame: this frame's, per node
   std::vector<std::array<double, 3>> a_, b_;
