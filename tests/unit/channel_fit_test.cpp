@@ -113,11 +113,20 @@ TEST_SUITE("channel_fit") {
     auto c = constant_channel(y.data(), 50, 0.04, 0.04, tol, 0.1);
     REQUIRE(c.has_value());
     CHECK(c->frames.empty());  // 0.04 rounds to the integer 0 at step 0.1, within 0.1
+    CHECK(c->step == 0.0625);  // the largest power of two up to the step
     y.assign(50, 3.0);
     c = constant_channel(y.data(), 50, 3.0, 3.0, tol, 0.1);
     REQUIRE(c.has_value());
     CHECK(c->frames == std::vector<uint32_t>{0});
-    CHECK(c->q == std::vector<int64_t>{30});
+    CHECK(c->step == 0.0625);
+    CHECK(c->q == std::vector<int64_t>{48});  // 3.0 exactly
+    // Where the power of two misses the tolerance and the step does not, the step.
+    std::vector<float> tight(50, 0.1f);  // tolerance 0.01
+    y.assign(50, 0.3);
+    c = constant_channel(y.data(), 50, 0.3, 0.3, {0.1, tight.data()}, 0.1);
+    REQUIRE(c.has_value());
+    CHECK(c->step == 0.1);  // 0.3 is 4.8 steps of 0.0625 (off by 0.0125), 3 of 0.1
+    CHECK(c->q == std::vector<int64_t>{3});
     y[20] = 3.5;
     CHECK_FALSE(constant_channel(y.data(), 50, 3.0, 3.5, tol, 0.1).has_value());
   }

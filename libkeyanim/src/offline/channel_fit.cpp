@@ -270,15 +270,26 @@ EncodedChannel channel_at(const double* y, Interpolation interp, float tension, 
 
 std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames, double lo, double hi,
                                                Tolerance tol, double step) {
+  // The largest power of two up to the step before the step: one key pays nothing for a finer
+  // step, and steps that repeat from channel to channel make CHAN compress (a 173-joint
+  // one-frame clip: 1.2 KB of steps become 0.2 KB). A channel without keys stores it too (its
+  // step means nothing); no key at all is tried first.
+  const double power_of_two = std::ldexp(1.0, std::ilogb(step));
+  auto within = [&](float v) {
+    uint32_t f = 0;
+    while (f < frames && std::fabs(double(v) - y[f]) <= tol.at(f)) ++f;
+    return f == frames;
+  };
   EncodedChannel ch;
-  ch.step = step;
-  if (frames == 0) return ch;
-  const int64_t q = quantize(0.5 * (lo + hi), step);
-  const float v = dequantize(q, step);
-  for (uint32_t f = 0; f < frames; ++f)
-    if (!(std::fabs(double(v) - y[f]) <= tol.at(f))) return std::nullopt;
-  if (q != 0) ch.frames = {0}, ch.q = {q};
-  return ch;
+  ch.step = power_of_two;
+  if (within(0.0f)) return ch;
+  for (const double s : {power_of_two, step}) {
+    const int64_t q = quantize(0.5 * (lo + hi), s);
+    if (!within(dequantize(q, s))) continue;
+    if (q != 0) ch.frames = {0}, ch.q = {q}, ch.step = s;
+    return ch;
+  }
+  return std::nullopt;
 }
 
 EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys, Tolerance tol,

@@ -132,7 +132,9 @@ struct ChannelFitOptions {
   bool force_linear = false; // linear only
 };
 
-// One key (or none for zero) if a single quantized value is within tolerance everywhere.
+// One key (or none for zero) if a single quantized value is within tolerance everywhere, with
+// the largest power of two up to `step` as its step where that is within tolerance too (and
+// always without keys).
 // `lo` and `hi` are the smallest and largest of y.
 std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames, double lo, double hi,
                                                Tolerance tol, double step);
