@@ -276,6 +276,15 @@ TEST_CASE("fk of two frames at once is bit for bit two frames one at a time") {
         }
         ++pairs;
       }
+      // The measured points too (shell points, either reading).
+      for (const auto reading : {keyanim::PositionReading::replace, keyanim::PositionReading::add}) {
+        keyanim::offline::measured_points(m.skeleton, m.frame(f), m.frame(g), 1.75, reading, a2, b2);
+        keyanim::offline::measured_points(m.skeleton, m.frame(f), 1.75, reading, a);
+        keyanim::offline::measured_points(m.skeleton, m.frame(g), 1.75, reading, b);
+        REQUIRE(a.size() == a2.size());
+        differ += std::memcmp(a.data(), a2.data(), a.size() * sizeof(Vec3)) != 0 ||
+                  std::memcmp(b.data(), b2.data(), b.size() * sizeof(Vec3)) != 0;
+      }
     }
   }
   CHECK(pairs > 1000);

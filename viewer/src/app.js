@@ -3,7 +3,7 @@
 import { decodeKanim, looksLikeKanim, nodeLabel } from './kanim.js';
 import { samplePose } from './sample.js';
 import { parseBvh } from './bvh.js';
-import { worldPositions, skeletonSize, largestDistance } from './pose.js';
+import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from './pose.js';
 import { View3D } from './view3d.js';
 import { CurvePanel } from './curves.js';
 import { clipFacts, noteLines } from './facts.js';
@@ -108,13 +108,27 @@ export class App {
     this.show(0);
   }
 
-  // Largest distance between original and decoded over every source frame both have.
+  // Largest distance between original and decoded over every source frame both have, on the
+  // points the encoder's error covers (joints, End Sites, shell points; each reading it lists).
   compareAllFrames() {
     const frames = Math.min(this.clip.frameCount, this.original.frameCount);
-    let worst = { distance: 0, node: 0, frame: 0 };
+    let worst = { distance: 0, node: 0, point: 0, frame: 0 };
     for (let f = 0; f < frames; ++f) {
-      const d = largestDistance(this.decodedAt(f), this.originalAt(f));
+      const d = this.compareAt(f);
       if (d.distance > worst.distance) worst = { ...d, frame: f };
+    }
+    return worst;
+  }
+
+  // The largest distance at source frame f, and where.
+  compareAt(f) {
+    const { shell, readings } = measuredSettings(this.clip.notes, this.size);
+    const o = this.original, values = samplePose(this.clip, f, this.values);
+    const row = o.frames.subarray(f * o.channelCount, (f + 1) * o.channelCount);
+    let worst = { distance: 0, node: 0, point: 0 };
+    for (const reading of readings) {
+      const d = largestDistance(measuredPoints(this.clip.nodes, values, shell, reading), measuredPoints(o.nodes, row, shell, reading), 4);
+      if (d.distance > worst.distance) worst = d;
     }
     return worst;
   }
@@ -137,10 +151,11 @@ export class App {
       // Compared at the nearest source frame: the original has nothing in between.
       const f = Math.min(Math.max(Math.round(x), 0), this.original.frameCount - 1);
       original = this.originalAt(f);
-      worst = largestDistance(f === x ? decoded : this.decodedAt(f), original);
+      worst = this.compareAt(f);
       const w = this.worstOverClip;
-      $('compare-frame').textContent = `${fmtLength(worst.distance)} at ${nodeLabel(clip.nodes, worst.node)} (${pct(worst.distance, this.size)} of the skeleton size${f === x ? '' : `; at frame ${f}, the nearest`})`;
-      $('compare-clip').textContent = `${fmtLength(w.distance)} at ${nodeLabel(clip.nodes, w.node)}, frame ${w.frame} (${pct(w.distance, this.size)})`;
+      const where = (d) => nodeLabel(clip.nodes, d.node) + (d.point ? ` shell ${'xyz'[d.point - 1]}` : '');
+      $('compare-frame').textContent = `${fmtLength(worst.distance)} at ${where(worst)} (${pct(worst.distance, this.size)} of the skeleton size${f === x ? '' : `; at frame ${f}, the nearest`})`;
+      $('compare-clip').textContent = `${fmtLength(w.distance)} at ${where(w)}, frame ${w.frame} (${pct(w.distance, this.size)})`;
     }
     this.view.setPoses(decoded, $('show-original').checked ? original : null, worst ? worst.node : -1);
     this.view.showOriginal($('show-original').checked);

@@ -63,14 +63,24 @@ export function skeletonSize(nodes) {
   return size;
 }
 
-// The largest distance between two position arrays of the same skeleton, and the node.
-export function largestDistance(a, b) {
-  let worst = 0, node = 0;
+// The largest distance between two point arrays of the same skeleton, `perNode` points per node
+// (1: worldPositions; 4: measuredPoints), and where: the node and its point (0: the node, 1-3:
+// its shell point on x, y, z).
+export function largestDistance(a, b, perNode = 1) {
+  let worst = 0, at = 0;
   for (let i = 0; i < a.length; i += 3) {
     const d = Math.hypot(a[i] - b[i], a[i + 1] - b[i + 1], a[i + 2] - b[i + 2]);
-    if (d > worst) { worst = d; node = i / 3; }
+    if (d > worst) { worst = d; at = i / 3; }
   }
-  return { distance: worst, node };
+  return { distance: worst, node: Math.floor(at / perNode), point: at % perNode };
+}
+
+// What the encoder's error covers, from the clip's notes: the shell distance (shell_units, else
+// 2% of `size`) and the readings of position channels (readings, else replace).
+export function measuredSettings(notes, size) {
+  const shell = Number(/^shell_units=(.*)$/m.exec(notes)?.[1]);
+  const readings = /^readings=(.*)$/m.exec(notes)?.[1]?.split(',') ?? ['replace'];
+  return { shell: Number.isFinite(shell) && shell >= 0 ? shell : 0.02 * size, readings };
 }
 
 // The points the encoder's error covers (keyanim/offline/metrics.h), 4 per node: the node, then

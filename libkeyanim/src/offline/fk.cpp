@@ -59,6 +59,11 @@ struct Lanes2 {
     _mm_store_pd(out, v);
     return out[i];
   }
+  // Both lanes into a and b, without a round trip through the stack.
+  void split(double& a, double& b) const {
+    _mm_storel_pd(&a, v);
+    _mm_storeh_pd(&b, v);
+  }
 };
 inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return Lanes2(_mm_add_pd(a.v, b.v)); }
 inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return Lanes2(_mm_sub_pd(a.v, b.v)); }
@@ -70,6 +75,7 @@ struct Lanes2 {
   explicit Lanes2(double v) : x{v, v} {}
   Lanes2(double a, double b) : x{a, b} {}
   double lane(int i) const { return x[i]; }
+  void split(double& a, double& b) const { a = x[0], b = x[1]; }
 };
 inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.x[0] + b.x[0], a.x[1] + b.x[1]}; }
 inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.x[0] - b.x[0], a.x[1] - b.x[1]}; }
@@ -278,27 +284,43 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const ui
   positions_with_scratch(skeleton, OneRow{frame_row}, out, nodes, reading);
 }
 
-void world_pose(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                PositionReading reading, std::vector<Vec3>& pos_a, std::vector<Vec3>& pos_b, std::vector<Mat3>* rot_a,
-                std::vector<Mat3>* rot_b) {
+void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b) {
   thread_local std::vector<std::array<Lanes2, 9>> rotations;
   thread_local std::vector<std::array<Lanes2, 3>> positions;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n), positions.resize(n);
-  pos_a.resize(n), pos_b.resize(n);
-  if (rot_a) rot_a->resize(n), rot_b->resize(n);
+  out_a.resize(4 * n), out_b.resize(4 * n);
   pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading);
+  const Lanes2 d(distance);
   for (size_t j = 0; j < n; ++j) {
     if (nodes && !nodes[j]) continue;
-    for (int a = 0; a < 3; ++a) pos_a[j][a] = positions[j][a].lane(0), pos_b[j][a] = positions[j][a].lane(1);
-    if (!rot_a) continue;
-    for (int e = 0; e < 9; ++e) (*rot_a)[j][e] = rotations[j][e].lane(0), (*rot_b)[j][e] = rotations[j][e].lane(1);
+    const std::array<Lanes2, 3>& p = positions[j];
+    const std::array<Lanes2, 9>& r = rotations[j];
+    Vec3* a = &out_a[4 * j];
+    Vec3* b = &out_b[4 * j];
+    for (int c = 0; c < 3; ++c) p[c].split(a[0][c], b[0][c]);
+    if (distance > 0.0 && !skeleton.joints[j].end_site) {
+      for (int axis = 0; axis < 3; ++axis)
+        for (int c = 0; c < 3; ++c) (p[c] + d * r[3 * c + axis]).split(a[1 + axis][c], b[1 + axis][c]);
+    } else {
+      a[1] = a[2] = a[3] = a[0], b[1] = b[2] = b[3] = b[0];
+    }
   }
 }
 
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
                      std::vector<Vec3>& out_a, std::vector<Vec3>& out_b, PositionReading reading) {
-  world_pose(skeleton, row_a, row_b, nodes, reading, out_a, out_b, nullptr, nullptr);
+  thread_local std::vector<std::array<Lanes2, 9>> rotations;
+  thread_local std::vector<std::array<Lanes2, 3>> positions;
+  const size_t n = skeleton.joints.size();
+  if (rotations.size() < n) rotations.resize(n), positions.resize(n);
+  out_a.resize(n), out_b.resize(n);
+  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading);
+  for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
+    for (int a = 0; a < 3; ++a) positions[j][a].split(out_a[j][a], out_b[j][a]);
+  }
 }
 
 void world_positions(const Skeleton& skeleton, const double* frame_row, const double* sines, const double* cosines,

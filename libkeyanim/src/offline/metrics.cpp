@@ -64,16 +64,8 @@ void measured_points(const Skeleton& skeleton, const double* frame_row, double s
 void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b, double shell,
                      PositionReading reading, std::vector<std::array<double, 3>>& points_a,
                      std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes) {
-  thread_local std::vector<Vec3> pos_a, pos_b;
-  thread_local std::vector<Mat3> rot_a, rot_b;
-  world_pose(skeleton, row_a, row_b, nodes, reading, pos_a, pos_b, &rot_a, &rot_b);
-  const size_t n = skeleton.joints.size();
-  points_a.resize(n * kPointsPerNode), points_b.resize(n * kPointsPerNode);
-  for (size_t j = 0; j < n; ++j) {
-    if (nodes && !nodes[j]) continue;
-    node_points(skeleton.joints[j], shell, pos_a[j], rot_a[j], &points_a[j * kPointsPerNode]);
-    node_points(skeleton.joints[j], shell, pos_b[j], rot_b[j], &points_b[j * kPointsPerNode]);
-  }
+  static_assert(kPointsPerNode == 4, "world_points gives the node and its three shell points");
+  world_points(skeleton, row_a, row_b, nodes, reading, shell, points_a, points_b);  // node_points, two at once
 }
 
 std::string point_name(const Skeleton& s, uint32_t node, uint32_t point) {

@@ -50,10 +50,12 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const ui
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
                      std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
                      PositionReading reading = PositionReading::replace);
-// The same with the world rotations too (null: not wanted), as world_pose gives them.
-void world_pose(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                PositionReading reading, std::vector<Vec3>& pos_a, std::vector<Vec3>& pos_b, std::vector<Mat3>* rot_a,
-                std::vector<Mat3>* rot_b);
+// Four points per node for two frame rows: node j's world position at out[4 j], then at
+// out[4 j + 1 + a] the point `distance` along column a of its world rotation (for an End Site,
+// or with distance 0, copies of its position), each computed as p + distance * R[.][a] from
+// what world_pose gives, bit for bit.
+void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
+                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values
