@@ -12,8 +12,9 @@
 namespace keyanim::cli {
 
 const char* const kPlotHelp =
-    "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--frames A:B] [--error E|E%]\n"
-    "                    [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
+    "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--frames A:B]\n"
+    "                    [--error E|E%] [--shell D|D%] [--keys MODE] [--tension T|fit]\n"
+    "                    [--level N] [-f]\n"
     "Encodes IN with the given settings and draws one channel over the frames: the original curve\n"
     "(rotations unwrapped), the decoder's reconstruction and one dot per key. Values in degrees for\n"
     "rotations, in file length units for positions.\n"
