@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""The README's sessions, pasted line by line: readme_session.py README.md
+"""The README's sessions, pasted line by line: readme_session.py [--write] README.md
 
 Runs, in the current directory and in order, every command of every session block of the README
 (a fenced block whose lines start with "$ ": the command, then what it prints), with bash, as a
 user pasting them would. Where the README shows output, what the command prints (standard output
 and error together) must be the same, compared word by word per line, except the timing columns
 of a table whose header ends in "enc ms  dec ms". Exits 1 on the first command that fails or
-prints something else, showing both.
+prints something else, showing both. With --write (for the maintainer who changed what a
+command prints), every output the README shows is replaced by what the command printed instead.
 """
 import re
 import subprocess
@@ -37,6 +38,30 @@ def parse(readme):
     return result
 
 
+def rewrite(readme, printed):
+    """The README with the output shown under each session command replaced by printed[i] (the
+    i-th command's lines), where the README shows any output for it."""
+    out, i, in_block, is_session, first, skipping = [], -1, False, False, False, False
+    for line in open(readme, encoding="utf-8").read().splitlines():
+        if line.startswith("```"):
+            in_block, is_session, first, skipping = not in_block, False, True, False
+        elif in_block and first:
+            is_session, first = line.startswith("$ "), False
+        if is_session and line.startswith("$ "):
+            i += 1
+            out.append(line)
+            skipping = False
+            continue
+        if is_session and in_block and not line.startswith("```"):
+            if not skipping:
+                out.extend(printed[i])
+                skipping = True
+            continue
+        out.append(line)
+    with open(readme, "w", encoding="utf-8") as f:
+        f.write("\n".join(out) + "\n")
+
+
 def words(line, timing, header):
     w = line.split()
     if timing:
@@ -57,23 +82,31 @@ def same(expected, actual):
 
 
 def main():
-    commands = parse(sys.argv[1])
+    write = sys.argv[1:2] == ["--write"]
+    readme = sys.argv[-1]
+    commands = parse(readme)
     if not commands:
-        print("FAIL: no session in", sys.argv[1])
+        print("FAIL: no session in", readme)
         return 1
+    printed = []
     for command, expected in commands:
         p = subprocess.run(["bash", "-c", command], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            text=True, timeout=600)
         actual = p.stdout.rstrip("\n").split("\n") if p.stdout.strip() else []
+        printed.append(actual)
         print("$", command)
         print(p.stdout, end="")
         if p.returncode != 0:
             print(f"FAIL: exit {p.returncode}")
             return 1
-        if expected and not same(expected, actual):
+        if expected and not write and not same(expected, actual):
             print("FAIL: the README shows:")
             print("\n".join(expected))
             return 1
+    if write:
+        rewrite(readme, printed)
+        print(f"readme session: {readme} shows what its {len(commands)} commands print now")
+        return 0
     print(f"readme session: {len(commands)} commands as the README shows them")
     return 0
 
