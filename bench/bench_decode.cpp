@@ -12,17 +12,16 @@
 //                       against cold_raw_copy_ns, a raw pose copy with its row flushed first
 //   load_mb_s           file bytes per second through Clip::load (validation included)
 // With --all, the same for every CMU 120 fps file of the corpus, with the bytes ACL needs at
-// the error keyanim reached (../shared/anchors, interpolated log-log).
+// the error keyanim reached under the shell metric (../shared/anchors/acl_shell.tsv,
+// interpolated log-log as keyanim eval --acl does).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -37,6 +36,7 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
+#include "acl_compare.h"
 #include "runtime/clip_access.h"
 
 namespace {
@@ -200,34 +200,6 @@ nlohmann::json measure(const Motion& m, bool speed) {
   return j;
 }
 
-// ACL's bytes at error e for a file (acl.tsv: joint and End Site positions), log-log between
-// the rows that bracket e, the nearest row outside them. 0 if the file has no rows.
-double acl_bytes_at(const std::string& file, double e) {
-  std::ifstream in(fs::path(KEYANIM_ANCHORS_DIR) / "acl.tsv");
-  std::string line;
-  std::vector<std::pair<double, double>> rows;  // error, bytes
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::istringstream f(line);
-    std::string name, frames, fps, thr, bytes, err;
-    if (std::getline(f, name, '\t') && name == file && std::getline(f, frames, '\t') && std::getline(f, fps, '\t') &&
-        std::getline(f, thr, '\t') && std::getline(f, bytes, '\t') && std::getline(f, err, '\t'))
-      rows.emplace_back(std::stod(err), std::stod(bytes));
-  }
-  if (rows.empty()) return 0.0;
-  std::sort(rows.begin(), rows.end());
-  if (e <= rows.front().first) return rows.front().second;
-  if (e >= rows.back().first) return rows.back().second;
-  for (size_t i = 1; i < rows.size(); ++i) {
-    if (e > rows[i].first) continue;
-    const auto [e0, b0] = rows[i - 1];
-    const auto [e1, b1] = rows[i];
-    const double t = (std::log(e) - std::log(e0)) / (std::log(e1) - std::log(e0));
-    return std::exp(std::log(b0) + t * (std::log(b1) - std::log(b0)));
-  }
-  return rows.back().second;
-}
-
 bool read(const fs::path& p, Motion& m) {
   keyanim::offline::BvhError err;
   if (keyanim::offline::read_bvh_file(p.string(), m, err)) return true;
@@ -256,15 +228,19 @@ int main(int argc, char** argv) {
     for (const auto& e : fs::directory_iterator(fs::path(KEYANIM_CORPUS_DIR) / "cmu")) files.push_back(e.path());
     std::sort(files.begin(), files.end());
     std::vector<double> over_acl;
+    std::string acl_error;  // ACL under the metric keyanim's encoder guarantees: the shell metric
+    const auto acl = keyanim::cli::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
+    if (!acl_error.empty()) std::cerr << "bench_decode: " << acl_error << " (no comparison with ACL)\n";
     for (const fs::path& p : files) {
       Motion mm;
       if (!read(p, mm) || mm.frame_time > 0.0105 || mm.frame_time < 0.0062) continue;  // 120 fps clips only
       nlohmann::json r = measure(mm, true);
       r["file"] = p.filename().string();
-      const double acl = acl_bytes_at(p.filename().string(), r.value("max_error", 0.0));
-      r["acl_bytes_at_equal_error"] = acl;
-      if (acl > 0) {
-        r["memory_over_acl"] = r["memory_bytes"].get<double>() / acl;
+      const auto it = acl.find(p.filename().string());
+      if (it != acl.end() && !it->second.rows.empty()) {
+        const double bytes = keyanim::cli::acl_at(it->second, r.value("max_error", 0.0))["bytes"].get<double>();
+        r["acl_bytes_at_equal_error"] = bytes;
+        r["memory_over_acl"] = r["memory_bytes"].get<double>() / bytes;
         over_acl.push_back(r["memory_over_acl"].get<double>());
       }
       j["all"].push_back(r);
