@@ -19,6 +19,9 @@ REQUIRED=(
   help2man man-db                                                     # the man page, and its test
   git                                                                 # the newcomer test's clone
   parallel procps  # tests/cli/manifest_test.sh runs the README's GNU parallel recipe (and kills it)
+  # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
+  # matplotlib for examples/plot_channel.py.
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
 )
 # For scripts/sanitize.sh's fuzz step and the clang build of the tests: clang with libFuzzer.
 # The runtime's package name differs (Debian 12: libclang-rt-14-dev; Ubuntu 24.04:

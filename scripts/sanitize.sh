@@ -43,7 +43,7 @@ start=$(date +%s)
 scripts/configure.sh "$B" -DCMAKE_CXX_COMPILER="$CXX_FOR_ASAN" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
   -DKEYANIM_SANITIZE=address,undefined -DKEYANIM_BUILD_FUZZ=$FUZZ -DKEYANIM_BUILD_BENCH=ON \
-  -DKEYANIM_BUILD_VIEWER=OFF  # JavaScript: nothing for the sanitizers; tested in build/
+  -DKEYANIM_BUILD_VIEWER=OFF -DKEYANIM_BUILD_PYTHON=OFF  # JavaScript and Python: tested in build/
 echo "$CXX_FOR_ASAN" >"$B/keyanim-compiler"
 cmake --build "$B" -j"$JOBS"
 echo "sanitize: build took $(( $(date +%s) - start )) s"

@@ -68,29 +68,8 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
   if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  const double raw = 4.0 * motion.frame_count * motion.channel_count();
   Encoded e;
-  e.summary = {
-      {"input", in},
-      {"output", out},
-      {"frames", motion.frame_count},
-      {"channels", motion.channel_count()},
-      {"frame_time", motion.frame_time},
-      {"keys", result.total_keys},
-      {"bvh_bytes", bvh_size},
-      {"raw_f32_bytes", static_cast<uint64_t>(raw)},
-      {"kanim_bytes", bytes.size()},
-      {"ratio_raw_f32", raw / double(bytes.size())},
-      {"error", error_json(motion.skeleton, result.error)},
-      {"encode_ms", encode_ms},
-  };
-  // Only error mode applies the tolerance; the other modes say whether --error held.
-  if (settings.key_mode == offline::KeyMode::error) {
-    e.summary["tolerance"] = result.tolerance_units;
-  } else {
-    e.summary["error_limit"] = result.tolerance_units;
-    e.summary["error_limit_met"] = result.error.max_error <= result.tolerance_units;
-  }
+  e.summary = encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);
   if (error_given) e.warning = tolerance_warning(settings, result.tolerance_units, result.error.max_error);
   output.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   output.commit();

@@ -1,8 +1,13 @@
 #include "report.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <set>
 
+#include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
+#include "keyanim/offline/notes.h"
 
 namespace keyanim::cli {
 
@@ -45,6 +50,128 @@ std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance
   std::snprintf(buf, sizeof buf, "error max %.6g exceeds --error %.6g%s (%.6g units), which --keys %s does not enforce",
                 max_error, s.tolerance, s.tolerance_in_percent ? "%" : "", tolerance_units, mode.c_str());
   return buf;
+}
+
+nlohmann::json encode_summary(const std::string& input, const std::string& output, const offline::Motion& motion,
+                              uint64_t bvh_bytes, const offline::EncodeSettings& settings,
+                              const offline::EncodeResult& result, uint64_t kanim_bytes, double encode_ms) {
+  const double raw = 4.0 * motion.frame_count * motion.channel_count();
+  nlohmann::json j = {
+      {"input", input},
+      {"output", output},
+      {"frames", motion.frame_count},
+      {"channels", motion.channel_count()},
+      {"frame_time", motion.frame_time},
+      {"keys", result.total_keys},
+      {"bvh_bytes", bvh_bytes},
+      {"raw_f32_bytes", static_cast<uint64_t>(raw)},
+      {"kanim_bytes", kanim_bytes},
+      {"ratio_raw_f32", raw / double(kanim_bytes)},
+      {"error", error_json(motion.skeleton, result.error)},
+      {"encode_ms", encode_ms},
+  };
+  // Only error mode applies the tolerance; the other modes say whether --error held.
+  if (settings.key_mode == offline::KeyMode::error) {
+    j["tolerance"] = result.tolerance_units;
+  } else {
+    j["error_limit"] = result.tolerance_units;
+    j["error_limit_met"] = result.error.max_error <= result.tolerance_units;
+  }
+  return j;
+}
+
+namespace {
+
+// Skeleton facts common to both kinds of file.
+nlohmann::json skeleton_json(const Skeleton& s) {
+  uint32_t joints = 0, end_sites = 0, roots = 0;
+  std::set<std::string> orders;
+  for (const Joint& j : s.joints) {
+    (j.end_site ? end_sites : joints) += 1;
+    roots += j.parent < 0;
+    std::string order;
+    for (ChannelType t : j.channels)
+      if (is_rotation(t)) order += char('X' + channel_axis(t));
+    if (!order.empty()) orders.insert(order);
+  }
+  return {{"joints", joints},
+          {"end_sites", end_sites},
+          {"roots", roots},
+          {"channels", s.channel_count()},
+          {"size", offline::skeleton_size(s)},
+          {"rotation_orders", std::vector<std::string>(orders.begin(), orders.end())}};
+}
+
+// What the encoder notes say was guaranteed (empty for a file without such notes).
+nlohmann::json guarantee_json(const std::string& notes) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const char* key : {"tolerance_units", "shell_units", "max_error"})
+    if (auto v = offline::note_number(notes, key)) j[key] = *v;
+  if (auto r = offline::note(notes, "readings")) {
+    j["readings"] = nlohmann::json::array();
+    for (size_t at = 0; at <= r->size();) {
+      const size_t comma = std::min(r->find(',', at), r->size());
+      j["readings"].push_back(r->substr(at, comma - at));
+      at = comma + 1;
+    }
+  }
+  for (const char* key : {"worst_point", "worst_reading"})
+    if (auto v = offline::note(notes, key)) j[key] = *v;
+  if (auto v = offline::note_number(notes, "worst_frame"); v && *v >= 0.0 && *v <= 4294967295.0 && *v == std::floor(*v))
+    j["worst_frame"] = uint32_t(*v);  // notes come from the file: only a frame number is taken as one
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json bvh_info(const std::string& file, uint64_t bytes, const offline::Motion& motion) {
+  nlohmann::json j = {{"file", file}, {"format", "bvh"}, {"bytes", bytes}};
+  j.update(skeleton_json(motion.skeleton));
+  j["frames"] = motion.frame_count;
+  j["frame_time"] = motion.frame_time;
+  return j;
+}
+
+nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& clip) {
+  nlohmann::json j = {{"file", file},
+                      {"format", "kanim"},
+                      {"version", std::to_string(clip.version_major()) + "." + std::to_string(clip.version_minor())},
+                      {"bytes", bytes},
+                      {"checksum", "ok"}};
+  j.update(skeleton_json(clip.skeleton()));
+  j["frames"] = clip.frame_count();
+  j["frame_time"] = clip.frame_time();
+  j["tangent_rule"] = clip.tangent_rule() == TangentRule::step_adjusted ? "step_adjusted" : "uniform";
+  std::vector<uint32_t> keys;
+  uint32_t zero = 0, constant = 0, linear = 0;
+  float t_min = 1.0f, t_max = -1.0f;
+  double t_sum = 0.0;
+  uint32_t curved = 0;
+  for (uint32_t c = 0; c < clip.channel_count(); ++c) {
+    const ChannelInfo t = clip.channel(c);
+    keys.push_back(t.key_count);
+    zero += t.key_count == 0;
+    constant += t.key_count == 1;
+    if (t.key_count < 2) continue;
+    if (t.interp == Interpolation::linear) { ++linear; continue; }
+    const float tension = t.tension;
+    t_min = std::min(t_min, tension), t_max = std::max(t_max, tension), t_sum += tension, ++curved;
+  }
+  std::sort(keys.begin(), keys.end());
+  j["keys"] = {{"total", clip.total_keys()},
+               {"per_channel_min", keys.empty() ? 0 : keys.front()},
+               {"per_channel_median", keys.empty() ? 0 : keys[keys.size() / 2]},
+               {"per_channel_max", keys.empty() ? 0 : keys.back()},
+               {"zero_channels", zero},
+               {"constant_channels", constant},
+               {"linear_channels", linear},
+               {"cardinal_channels", curved}};
+  if (curved) j["tension"] = {{"min", t_min}, {"mean", t_sum / curved}, {"max", t_max}};
+  j["raw_f32_bytes"] = uint64_t(4) * clip.frame_count() * clip.channel_count();
+  j["memory_bytes"] = clip.memory_bytes();
+  j["encoder_notes"] = clip.encoder_notes();
+  if (nlohmann::json noted = guarantee_json(clip.encoder_notes()); !noted.empty()) j["guarantee"] = noted;
+  return j;
 }
 
 }  // namespace keyanim::cli

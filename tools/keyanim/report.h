@@ -1,8 +1,10 @@
-// JSON and one-line text renderings of what the library measured, shared by the commands.
+// JSON and one-line text renderings of what the library measured, shared by the commands and
+// the Python module (python/: its encode report and Clip.info are these very objects).
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "keyanim/clip.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/skeleton.h"
 
@@ -22,5 +24,15 @@ std::string error_text(const Skeleton& s, const offline::ErrorReport& e);
 // Empty, or a warning when --error was given with a key mode that does not apply it (uniform,
 // manual, curvature) and the error reached exceeds it.
 std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance_units, double max_error);
+
+// What `keyanim encode --json` prints for one input: sizes, keys, the error reached and the
+// tolerance (error mode) or error_limit and error_limit_met (the other key modes).
+nlohmann::json encode_summary(const std::string& input, const std::string& output, const offline::Motion& motion,
+                              uint64_t bvh_bytes, const offline::EncodeSettings& settings,
+                              const offline::EncodeResult& result, uint64_t kanim_bytes, double encode_ms);
+
+// What `keyanim info --json` prints for a BVH file and for a .kanim file of `bytes` bytes.
+nlohmann::json bvh_info(const std::string& file, uint64_t bytes, const offline::Motion& motion);
+nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& clip);
 
 }  // namespace keyanim::cli

@@ -1,6 +1,8 @@
 #include "settings.h"
 
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/keyframes.h"
+#include "keyanim/offline/settings_text.h"
 
 namespace keyanim::cli {
 
@@ -27,12 +29,13 @@ std::string encoder_options_help(bool with_error) {
   return std::string(with_error ? error : "") + others;
 }
 
+// The library's grammar (settings_text.h); its errors are usage errors naming the option.
 void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
-  std::string t = text;
-  s.tolerance_in_percent = !t.empty() && t.back() == '%';
-  if (s.tolerance_in_percent) t.pop_back();
-  s.tolerance = parse_double(option, t);
-  if (!(s.tolerance > 0.0)) fail(kUsage, option + " must be positive, got '" + text + "'");
+  try {
+    offline::parse_tolerance(text, s);
+  } catch (const offline::Error& e) {
+    fail(kUsage, option + ": " + e.message());
+  }
 }
 
 void parse_shell(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
@@ -45,27 +48,10 @@ void parse_shell(const std::string& text, offline::EncodeSettings& s, const std:
 }
 
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
-  const size_t colon = text.find(':');
-  const std::string mode = text.substr(0, colon);
-  const std::string arg = colon == std::string::npos ? "" : text.substr(colon + 1);
-  if (mode == "error" && colon == std::string::npos) {
-    s.key_mode = offline::KeyMode::error;
-  } else if (mode == "curvature" && colon == std::string::npos) {
-    s.key_mode = offline::KeyMode::curvature;
-  } else if (mode == "uniform" && !arg.empty()) {
-    s.key_mode = offline::KeyMode::uniform;
-    s.uniform_interval = parse_uint("--keys uniform:N", arg);
-    if (s.uniform_interval < 1) fail(kUsage, "--keys uniform:N needs N >= 1");
-  } else if (mode == "manual" && !arg.empty()) {
-    s.key_mode = offline::KeyMode::manual;
-    size_t start = 0;
-    while (start <= arg.size()) {
-      const size_t comma = std::min(arg.find(',', start), arg.size());
-      s.manual_frames.push_back(parse_uint("--keys manual:F1,F2,...", arg.substr(start, comma - start)));
-      start = comma + 1;
-    }
-  } else {
-    fail(kUsage, "--keys expects error, uniform:N, manual:F1,F2,... or curvature, got '" + text + "'");
+  try {
+    offline::parse_key_mode(text, s);
+  } catch (const offline::Error& e) {
+    fail(kUsage, "--keys: " + e.message());
   }
 }
 

@@ -258,6 +258,29 @@ Mat3 local_rotation(const Joint& joint, const double* frame_row) {
   return m;
 }
 
+Quat local_quaternion(const Joint& joint, const double* frame_row) {
+  Quat q{0, 0, 0, 1};
+  const double* v = frame_row + joint.first_channel;
+  for (size_t k = 0; k < joint.channels.size(); ++k)
+    if (is_rotation(joint.channels[k])) q = quat_multiply(q, axis_quaternion(channel_axis(joint.channels[k]), v[k]));
+  return q;
+}
+
+Quat axis_quaternion(int axis, double degrees) {
+  double s, c;
+  sin_cos_deg(0.5 * degrees, s, c);
+  Quat q{0, 0, 0, c};
+  q[size_t(axis)] = s;
+  return q;
+}
+
+Quat quat_multiply(const Quat& a, const Quat& b) noexcept {
+  return {a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+          a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+          a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+          a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]};
+}
+
 namespace {
 
 // World positions into `out`, with a per-thread rotation scratch so that the encoder's

@@ -150,23 +150,9 @@ Sampler resampled_rotation(const NodeCurves& node, const std::vector<ChannelCurv
   return s;
 }
 
-Quat quat_mul(const Quat& a, const Quat& b) noexcept {
-  return {a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
-          a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
-          a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
-          a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2]};
-}
-
 namespace {
 
-// Rotation about one axis by `degrees`, and its derivative per degree.
-Quat axis_quat(int axis, double degrees) {
-  double s, c;
-  sin_cos_deg(0.5 * degrees, s, c);
-  Quat q{0, 0, 0, c};
-  q[size_t(axis)] = s;
-  return q;
-}
+// The derivative per degree of a rotation about one axis (fk.h: axis_quaternion).
 Quat axis_quat_derivative(int axis, double degrees) {
   double s, c;
   sin_cos_deg(0.5 * degrees, s, c);
@@ -181,7 +167,7 @@ Quat axis_quat_derivative(int axis, double degrees) {
 Quat rotation_at(const NodeCurves& node, const std::vector<ChannelCurve>& curves, double frame_position) {
   Quat q{0, 0, 0, 1};
   for (const auto& [axis, c] : node.rotation)
-    q = quat_mul(q, axis_quat(axis, curves[size_t(c)].value(frame_position)));
+    q = quat_multiply(q, axis_quaternion(axis, curves[size_t(c)].value(frame_position)));
   return q;
 }
 
@@ -194,14 +180,14 @@ Quat rotation_rate(const NodeCurves& node, const std::vector<ChannelCurve>& curv
     const auto& [axis, c] = node.rotation[i];
     const double a = curves[size_t(c)].value(f);
     const double rate = curves[size_t(c)].slope(f, from_left) / frame_time;  // degrees per second
-    q[i] = axis_quat(axis, a);
+    q[i] = axis_quaternion(axis, a);
     dq[i] = axis_quat_derivative(axis, a);
     for (double& v : dq[i]) v *= rate;
   }
   Quat sum{0, 0, 0, 0};
   for (size_t i = 0; i < m; ++i) {
     Quat term{0, 0, 0, 1};
-    for (size_t k = 0; k < m; ++k) term = quat_mul(term, k == i ? dq[k] : q[k]);
+    for (size_t k = 0; k < m; ++k) term = quat_multiply(term, k == i ? dq[k] : q[k]);
     for (int e = 0; e < 4; ++e) sum[e] += term[e];
   }
   return sum;

@@ -72,6 +72,4 @@ Quat rotation_at(const NodeCurves& node, const std::vector<ChannelCurve>& curves
 Quat rotation_rate(const NodeCurves& node, const std::vector<ChannelCurve>& curves, uint32_t f, bool from_left,
                    double frame_time);
 
-Quat quat_mul(const Quat& a, const Quat& b) noexcept;
-
 }  // namespace keyanim::offline::gltf

@@ -30,9 +30,17 @@ namespace keyanim::offline {
 
 using Vec3 = std::array<double, 3>;
 using Mat3 = std::array<double, 9>;  // row-major
+using Quat = std::array<double, 4>;  // x, y, z, w (glTF's and keyanim::Transform's order)
 
 // Rotation matrix of one joint from its channel values (frame row), Euler order as listed.
 Mat3 local_rotation(const Joint& joint, const double* frame_row);
+// The same rotation as a unit quaternion, q = q_1 q_2 q_3 over the channels in order (the
+// identity for a node without rotation channels), with the sines and cosines FK uses.
+Quat local_quaternion(const Joint& joint, const double* frame_row);
+// Rotation by `degrees` about axis 0, 1 or 2 (x, y, z): (sin(a/2) axis, cos(a/2)).
+Quat axis_quaternion(int axis, double degrees);
+// a * b (Hamilton product): b applied first.
+Quat quat_multiply(const Quat& a, const Quat& b) noexcept;
 
 // World positions of every node (joints and End Sites) for one frame row of values.
 // `out` is resized to skeleton.joints.size(). Allocates nothing once `out` and a per-thread

@@ -1,0 +1,20 @@
+// Encoder settings written as text, one grammar for every front end (the keyanim tool's
+// --error and --keys, the Python module's encode(error=..., keys=...)).
+#pragma once
+#include <string_view>
+
+#include "keyanim/offline/encode.h"
+
+namespace keyanim::offline {
+
+// "0.05%" (percent of the skeleton size) or "0.1" (file length units) -> settings.tolerance
+// and tolerance_in_percent. Throws Error (invalid_argument) unless a positive finite number
+// (at most 100 in percent).
+void parse_tolerance(std::string_view text, EncodeSettings& settings);
+
+// "error", "uniform:N" (N >= 1), "manual:F1,F2,..." or "curvature" -> settings.key_mode and
+// uniform_interval or manual_frames. Throws Error (invalid_argument) otherwise. (Manual frames
+// are checked against a motion by encode.)
+void parse_key_mode(std::string_view text, EncodeSettings& settings);
+
+}  // namespace keyanim::offline

@@ -1,0 +1,242 @@
+// keyanim.Clip: a .kanim loaded and sampled in bulk (the GIL released), its info, decoding back
+// to a Motion, and a clip made from a Motion's own frames.
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "common.h"
+#include "dense_clip.h"
+#include "keyanim/offline/decode.h"
+#include "keyanim/offline/error.h"
+
+namespace keyanim::python {
+namespace {
+
+// The whole file, or Error::io with errno; Error (limit) past the loader's size limit.
+std::vector<uint8_t> read_file(const std::string& path, uint64_t max_bytes) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) throw offline::Error::io(path, "cannot open file", errno);
+  std::vector<uint8_t> bytes;
+  uint8_t chunk[1 << 16];
+  for (;;) {
+    const size_t n = std::fread(chunk, 1, sizeof chunk, f.get());
+    if (bytes.size() + n > max_bytes)
+      throw offline::Error(offline::ErrorKind::limit, "larger than the loader's limit of " + std::to_string(max_bytes) + " bytes", path);
+    bytes.insert(bytes.end(), chunk, chunk + n);
+    if (n < sizeof chunk) break;
+  }
+  if (std::ferror(f.get())) throw offline::Error::io(path, "cannot read file", errno ? errno : EIO);
+  return bytes;
+}
+
+std::shared_ptr<PyClip> load(const py::object& source) {
+  auto c = std::make_shared<PyClip>();
+  std::vector<uint8_t> bytes;
+  const bool in_memory = py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source) ||
+                         py::isinstance<py::memoryview>(source);
+  if (in_memory) {
+    const py::buffer_info buf = py::reinterpret_borrow<py::buffer>(source).request();
+    const auto* data = static_cast<const uint8_t*>(buf.ptr);
+    bytes.assign(data, data + buf.size * buf.itemsize);
+  } else {
+    c->file = path_of(source);
+  }
+  py::gil_scoped_release unlocked;
+  if (c->file) bytes = read_file(*c->file, DecodeLimits{}.max_decompressed_bytes);
+  ErrorInfo info;
+  if (Clip::load(bytes, c->clip, &info) != Status::ok) throw offline::Error::kanim(c->file.value_or(""), info);
+  c->bytes = bytes.size();
+  return c;
+}
+
+PositionReading reading_arg(const std::string& r) {
+  if (r == "replace") return PositionReading::replace;
+  if (r == "add") return PositionReading::add;
+  throw py::value_error("position_reading must be 'replace' (Blender's reading, the default) or 'add' (three.js), got '" + r + "'");
+}
+
+// Frame positions from times (seconds) or frames: exactly one of them.
+Positions where(const PyClip& c, const py::handle& times, const py::handle& frames) {
+  if (times.is_none() == frames.is_none()) throw py::type_error("give either times or frames (keyword), not both or neither");
+  if (!frames.is_none()) return positions_arg(frames, "frames");
+  Positions p = positions_arg(times, "times");
+  const double ft = c.clip.frame_time();
+  for (double& t : p.values) t = ft > 0.0 ? t / ft : 0.0;  // as Clip::sample_time
+  return p;
+}
+
+py::array_t<float> sample(const PyClip& c, const Positions& p) {
+  const size_t width = c.clip.channel_count();
+  py::array_t<float> out(shape_with(p.shape, {py::ssize_t(width)}));
+  float* data = out.mutable_data();
+  py::gil_scoped_release unlocked;
+  Cursor cursor;
+  if (cursor.prepare(c.clip) != Status::ok) throw std::bad_alloc();
+  for (size_t i = 0; i < p.values.size(); ++i) c.clip.sample(p.values[i], {data + i * width, width}, &cursor);
+  return out;
+}
+
+// Local or model transforms at every position: quaternions (..., nodes, 4), translations (..., nodes, 3).
+std::pair<py::array_t<float>, py::array_t<float>> transforms(const PyClip& c, const Positions& p, bool model,
+                                                             PositionReading reading, bool with_rotations) {
+  const size_t nodes = c.clip.skeleton().joints.size();
+  py::array_t<float> rotations(shape_with(p.shape, {py::ssize_t(with_rotations ? nodes : 0), 4}));
+  py::array_t<float> translations(shape_with(p.shape, {py::ssize_t(nodes), 3}));
+  float* q = rotations.mutable_data();
+  float* t = translations.mutable_data();
+  py::gil_scoped_release unlocked;
+  Cursor cursor;
+  if (cursor.prepare(c.clip) != Status::ok) throw std::bad_alloc();
+  std::vector<Transform> pose(nodes);
+  for (size_t i = 0; i < p.values.size(); ++i) {
+    if (model) c.clip.sample_model(p.values[i], pose, &cursor, reading);
+    else c.clip.sample_local(p.values[i], pose, &cursor, reading);
+    for (size_t j = 0; j < nodes; ++j) {
+      if (with_rotations) std::copy(pose[j].rotation, pose[j].rotation + 4, q + (i * nodes + j) * 4);
+      std::copy(pose[j].translation, pose[j].translation + 3, t + (i * nodes + j) * 3);
+    }
+  }
+  return {rotations, translations};
+}
+
+// A channel number (negative: from the end), IndexError outside the clip's channels.
+uint32_t channel_index(const PyClip& c, int64_t channel) {
+  const int64_t n = c.clip.channel_count();
+  if (channel < -n || channel >= n)
+    throw py::index_error("channel " + std::to_string(channel) + " is out of range for " + std::to_string(n) + " channels");
+  return uint32_t(channel < 0 ? channel + n : channel);
+}
+
+const char* const kClipDoc =
+    "Clip(path_or_bytes): a .kanim file loaded (validated completely: a damaged file raises\n"
+    "keyanim.Error with its section and byte offset), sampled at any time or frame position.\n"
+    "Values between frames come from the clip's curves. Sampling many positions at once releases\n"
+    "the GIL, so threads sampling clips run in parallel. Nodes are the joints and End Sites in\n"
+    "file order.";
+
+}  // namespace
+
+void register_clip(py::module_& m) {
+  py::class_<PyClip, std::shared_ptr<PyClip>> cls(m, "Clip", kClipDoc);
+  cls.def(py::init(&load), py::arg("path_or_bytes"),
+          "Loads a .kanim from a path (str or os.PathLike) or from bytes (bytes, bytearray,\n"
+          "memoryview).");
+  cls.def_static(
+      "from_motion",
+      [](const PyMotion& motion) {
+        auto c = std::make_shared<PyClip>();
+        py::gil_scoped_release unlocked;
+        c->clip = dense_clip(motion.motion);
+        return c;
+      },
+      py::arg("motion"),
+      "A clip holding every frame of `motion` as a key (no encoding, no keys dropped): Catmull-Rom\n"
+      "curves through the source frames, for sampling a BVH at other times or rates as .kanim\n"
+      "clips are sampled. Values at the frames are within half a float32 step of the channel's\n"
+      "largest magnitude; angles are unwrapped (consecutive frames differ by less than 180\n"
+      "degrees) as the encoder unwraps them.");
+  cls.def_property_readonly("frame_count", [](const PyClip& c) { return c.clip.frame_count(); }, "Number of source frames.");
+  cls.def_property_readonly("frame_time", [](const PyClip& c) { return c.clip.frame_time(); }, "Seconds between frames.");
+  cls.def_property_readonly("duration", [](const PyClip& c) { return c.clip.duration(); },
+                            "(frame_count - 1) * frame_time seconds, 0 without frames.");
+  cls.def_property_readonly("channel_count", [](const PyClip& c) { return c.clip.channel_count(); }, "Values per frame.");
+  cls.def_property_readonly("total_keys", [](const PyClip& c) { return c.clip.total_keys(); }, "Keys over every channel.");
+  cls.def_property_readonly("memory_bytes", [](const PyClip& c) { return c.clip.memory_bytes(); },
+                            "Bytes the loaded clip holds in memory.");
+  cls.def_property_readonly("encoder_notes", [](const PyClip& c) { return text(c.clip.encoder_notes()); },
+                            "The encoder's key=value notes stored in the file (settings, error reached).");
+  cls.def_property_readonly(
+      "file", [](const PyClip& c) { return c.file ? py::object(text(*c.file)) : py::object(py::none()); },
+      "The file it was loaded from, or None.");
+  def_skeleton_properties(cls, [](const PyClip& c) -> const Skeleton& { return c.clip.skeleton(); });
+  cls.def_property_readonly(
+      "info",
+      [](const PyClip& c) {
+        py::dict info = to_python(cli::kanim_info(c.file.value_or(""), c.bytes, c.clip));
+        if (!c.file) info["file"] = py::none();
+        return info;
+      },
+      "A dict with the keys of `keyanim info --json` (version, frames, frame_time, joints,\n"
+      "channels, size, keys per channel, tensions, memory_bytes, encoder_notes, ...).");
+  cls.def(
+      "sample", [](const PyClip& c, const py::handle& times) { return sample(c, where(c, times, py::none())); },
+      py::arg("times"),
+      "Every channel at each time in seconds: float32 array times.shape + (channels,). Times\n"
+      "are clamped to the clip; between frames the values are in-betweens.");
+  cls.def(
+      "sample_frames", [](const PyClip& c, const py::handle& frames) { return sample(c, where(c, py::none(), frames)); },
+      py::arg("frames"),
+      "Every channel at each frame position (fractional positions are in-betweens): float32\n"
+      "array frames.shape + (channels,).");
+  cls.def(
+      "local_transforms",
+      [](const PyClip& c, const py::handle& times, const py::handle& frames, const std::string& reading) {
+        auto [q, t] = transforms(c, where(c, times, frames), false, reading_arg(reading), true);
+        return py::make_tuple(q, t);
+      },
+      py::arg("times") = py::none(), py::kw_only(), py::arg("frames") = py::none(),
+      py::arg("position_reading") = "replace",
+      "Each node's local transform at each time (or frame position, with frames=): a tuple of\n"
+      "quaternions, float32 times.shape + (nodes, 4) as (x, y, z, w), and translations,\n"
+      "times.shape + (nodes, 3). Quaternions are continuous in time. position_reading: how\n"
+      "position channels combine with OFFSET, 'replace' (Blender, keyanim's forward kinematics)\n"
+      "or 'add' (three.js).");
+  cls.def(
+      "world_positions",
+      [](const PyClip& c, const py::handle& times, const py::handle& frames, const std::string& reading) {
+        return transforms(c, where(c, times, frames), true, reading_arg(reading), false).second;
+      },
+      py::arg("times") = py::none(), py::kw_only(), py::arg("frames") = py::none(),
+      py::arg("position_reading") = "replace",
+      "World (model-space) position of every node at each time (or frame position, with\n"
+      "frames=): float32 array times.shape + (nodes, 3).");
+  cls.def(
+      "channel",
+      [](const PyClip& c, int64_t channel) {
+        const ChannelInfo info = c.clip.channel(channel_index(c, channel));
+        py::dict d;
+        d["interpolation"] = info.interp == Interpolation::linear ? "linear" : "cardinal";
+        d["tension"] = info.tension;
+        d["key_count"] = info.key_count;
+        return d;
+      },
+      py::arg("channel"),
+      "How one channel (index into channel_names) is stored: a dict with interpolation\n"
+      "('cardinal' or 'linear'), tension (in [-1, 1]; 0 is Catmull-Rom) and key_count.");
+  cls.def(
+      "channel_keys",
+      [](const PyClip& c, int64_t index) {
+        const uint32_t channel = channel_index(c, index);
+        const uint32_t n = c.clip.channel(channel).key_count;
+        py::array_t<uint32_t> frames(n);
+        py::array_t<float> values(n);
+        c.clip.channel_keys(channel, {frames.mutable_data(), n}, {values.mutable_data(), n});
+        return py::make_tuple(frames, values);
+      },
+      py::arg("channel"),
+      "The keys of one channel (index into channel_names): frames (uint32) and values (float32),\n"
+      "exactly as the sampler uses them. No keys: the channel is 0 throughout; one: constant.");
+  cls.def(
+      "to_motion",
+      [](const PyClip& c, const py::handle& fps) {
+        offline::ResampleOptions options;
+        if (!fps.is_none()) options.fps = fps.cast<double>();
+        auto out = std::make_shared<PyMotion>();
+        py::gil_scoped_release unlocked;
+        std::string why;
+        if (!offline::decode_motion(c.clip, options, out->motion, why))
+          throw offline::Error(offline::ErrorKind::invalid_argument, why);
+        return out;
+      },
+      py::arg("fps") = py::none(),
+      "Decodes the clip to a Motion: at the source frames (fps=None), or at frames every 1/fps\n"
+      "seconds from the start up to the end (motion tweening: the in-betweens come from the curves).");
+  cls.def("__repr__", [](const PyClip& c) {
+    return "<keyanim.Clip: " + std::to_string(c.clip.frame_count()) + " frames, " +
+           std::to_string(c.clip.skeleton().joints.size()) + " nodes, " + std::to_string(c.clip.channel_count()) +
+           " channels, " + std::to_string(c.clip.total_keys()) + " keys>";
+  });
+}
+
+}  // namespace keyanim::python

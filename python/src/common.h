@@ -1,0 +1,72 @@
+// The Python module's shared pieces: the objects it wraps, text and path conversion, JSON to
+// Python, and the registration function of each part (one file per part of the API).
+#pragma once
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "keyanim/clip.h"
+#include "keyanim/offline/motion.h"
+
+namespace keyanim::python {
+
+namespace py = pybind11;
+
+// keyanim.Motion: a motion and, when it was read from a file, the file's path and size (the
+// encode report gives them as input and bvh_bytes).
+struct PyMotion {
+  offline::Motion motion;
+  std::optional<std::string> source;
+  std::optional<uint64_t> bvh_bytes;
+};
+
+// keyanim.Clip: a loaded clip, and the file and byte count it came from (the info dict).
+struct PyClip {
+  Clip clip;
+  std::optional<std::string> file;
+  uint64_t bytes = 0;
+};
+
+// Text from files (joint names, notes) may hold any bytes: bytes that are not UTF-8 become
+// lone surrogates (PEP 383, "surrogateescape"), as `keyanim ... --json` writes them.
+py::str text(const std::string& bytes);
+// str, bytes or os.PathLike -> the path's bytes (os.fsencode).
+std::string path_of(const py::handle& path);
+// A JSON value of the CLI's reports as Python objects (dict, list, str, int, float, bool, None).
+py::object to_python(const nlohmann::json& j);
+
+// A float64 array of frame indices or times as a flat vector, with the array's shape kept for
+// the result. Rejects NaN (ValueError).
+struct Positions {
+  std::vector<double> values;
+  std::vector<py::ssize_t> shape;
+};
+Positions positions_arg(const py::handle& array, const char* what);
+// Shape `lead` followed by `tail`.
+std::vector<py::ssize_t> shape_with(std::vector<py::ssize_t> lead, std::initializer_list<py::ssize_t> tail);
+
+// Frame indices for Motion methods: None -> every frame; else integers in [0, frame_count)
+// (negative ones count from the end, as in numpy), IndexError otherwise; the shape is kept.
+struct FrameList {
+  std::vector<uint32_t> frames;
+  std::vector<py::ssize_t> shape;
+};
+FrameList frames_arg(const py::handle& frames, uint32_t frame_count);
+
+// Skeleton properties shared by Motion and Clip (joint_names, parents, offsets, ...).
+template <class Class, class Get>
+void def_skeleton_properties(Class& cls, Get skeleton_of);
+
+void register_errors(py::module_& m);
+void register_motion(py::module_& m);
+void register_encode(py::module_& m);
+void register_clip(py::module_& m);
+
+}  // namespace keyanim::python
+
+#include "skeleton_properties.h"

@@ -1,0 +1,199 @@
+// keyanim.read_bvh, keyanim.Motion (its channels as a numpy view, BVH writing, forward
+// kinematics) and keyanim.measure_error.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include "common.h"
+#include "keyanim/offline/bvh.h"
+#include "keyanim/offline/error.h"
+#include "keyanim/offline/fk.h"
+#include "keyanim/offline/metrics.h"
+
+namespace keyanim::python {
+namespace {
+
+// BVH text of `path` as a Motion; warnings (more motion lines than Frames: declares) are
+// Python warnings.
+PyMotion read(const py::handle& path_arg) {
+  PyMotion m;
+  m.source = path_of(path_arg);
+  std::vector<std::string> warnings;
+  {
+    py::gil_scoped_release unlocked;
+    offline::BvhError err;
+    if (!offline::read_bvh_file(*m.source, m.motion, err, &warnings)) {
+      if (err.line == 0) {  // an I/O failure: open again for its errno
+        std::FILE* f = std::fopen(m.source->c_str(), "rb");
+        if (f == nullptr) throw offline::Error::io(err.file, "cannot open file", errno);
+        std::fclose(f);
+        if (std::filesystem::is_directory(*m.source)) throw offline::Error::io(err.file, "cannot read file", EISDIR);
+      }
+      throw offline::Error::bvh(err.file, err.line, err.column, err.message);
+    }
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(*m.source, ec);
+    if (!ec) m.bvh_bytes = size;
+  }
+  for (const std::string& w : warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, std::string(py::str(text(w))).c_str(), 1) != 0) throw py::error_already_set();
+  return m;
+}
+
+// Writes through a temporary file beside `path`, renamed over it once complete; an existing
+// file is replaced only with overwrite.
+void write_bvh_file(const offline::Motion& motion, const std::string& path, bool overwrite) {
+  std::error_code ec;
+  if (!overwrite && std::filesystem::symlink_status(path, ec).type() != std::filesystem::file_type::not_found && !ec)
+    throw offline::Error::io(path, "exists (pass overwrite=True to replace it)", EEXIST);
+  const std::filesystem::path target(path);
+  const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
+  std::string temp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  const int fd = mkstemp(temp.data());
+  if (fd < 0) throw offline::Error::io(path, "cannot create a temporary file beside it", errno);
+  int failed = 0;
+  auto put = [&](std::string_view chunk) {
+    for (size_t done = 0; done < chunk.size() && !failed;) {
+      const ssize_t n = ::write(fd, chunk.data() + done, chunk.size() - done);
+      if (n < 0 && errno != EINTR) failed = errno;
+      if (n > 0) done += size_t(n);
+    }
+  };
+  offline::BvhWriter writer(motion.skeleton, motion.frame_count, motion.frame_time, put);
+  for (uint32_t f = 0; f < motion.frame_count && !failed; ++f) writer.frame(motion.frame(f));
+  writer.finish();
+  if (!failed && ::fchmod(fd, 0644) != 0) failed = errno;
+  if (::close(fd) != 0 && !failed) failed = errno;
+  if (!failed && std::rename(temp.c_str(), path.c_str()) != 0) failed = errno;
+  if (failed) {
+    std::remove(temp.c_str());
+    throw offline::Error::io(path, "cannot write", failed);
+  }
+}
+
+// Per frame of `frames`, `per_node` values for every node, from `pose(row, node, out)`.
+template <class Pose>
+py::array_t<double> per_node(const PyMotion& m, const py::handle& frames_arg_, size_t width, Pose pose) {
+  const offline::Motion& motion = m.motion;
+  const FrameList list = frames_arg(frames_arg_, motion.frame_count);
+  const size_t nodes = motion.skeleton.joints.size();
+  py::array_t<double> out(shape_with(list.shape, {py::ssize_t(nodes), py::ssize_t(width)}));
+  double* data = out.mutable_data();
+  py::gil_scoped_release unlocked;
+  for (size_t i = 0; i < list.frames.size(); ++i) pose(motion.frame(list.frames[i]), data + i * nodes * width);
+  return out;
+}
+
+const char* const kMotionDoc =
+    "A motion read from BVH (keyanim.read_bvh) or decoded from a clip (Clip.to_motion): a\n"
+    "skeleton and a frames x channels matrix of values, exactly as the file holds them.\n"
+    "Nodes are the joints and End Sites in file order; `channels` columns follow\n"
+    "`channel_names`. Angles are in degrees, lengths in the file's units.";
+
+}  // namespace
+
+void register_motion(py::module_& m) {
+  py::class_<PyMotion, std::shared_ptr<PyMotion>> cls(m, "Motion", kMotionDoc);
+  cls.def_property_readonly("frame_count", [](const PyMotion& self) { return self.motion.frame_count; },
+                            "Number of frames.");
+  cls.def_property_readonly("frame_time", [](const PyMotion& self) { return self.motion.frame_time; },
+                            "Seconds between frames (frame i is at i * frame_time).");
+  cls.def_property_readonly("channel_count", [](const PyMotion& self) { return self.motion.channel_count(); },
+                            "Number of channels (values per frame).");
+  cls.def_property_readonly(
+      "source", [](const PyMotion& self) { return self.source ? py::object(text(*self.source)) : py::object(py::none()); },
+      "The BVH file it was read from, or None.");
+  cls.def_property(
+      "channels",
+      [](py::object self) {
+        PyMotion& p = self.cast<PyMotion&>();
+        const py::ssize_t frames = p.motion.frame_count, channels = p.motion.channel_count();
+        static double empty = 0.0;  // numpy needs a pointer even for no values
+        double* data = p.motion.values.empty() ? &empty : p.motion.values.data();
+        return py::array_t<double>({frames, channels}, {py::ssize_t(sizeof(double)) * channels, py::ssize_t(sizeof(double))},
+                                   data, self);
+      },
+      [](PyMotion& self, const py::array_t<double, py::array::c_style | py::array::forcecast>& values) {
+        const py::ssize_t frames = self.motion.frame_count, channels = self.motion.channel_count();
+        if (values.ndim() != 2 || values.shape(0) != frames || values.shape(1) != channels)
+          throw py::value_error("channels must have shape (" + std::to_string(frames) + ", " + std::to_string(channels) + ")");
+        std::copy(values.data(), values.data() + values.size(), self.motion.values.begin());
+      },
+      "float64 array (frames, channels): the motion's values, a view that writes through (edit it,\n"
+      "then write_bvh or encode). Assigning an array of the same shape copies it in.");
+  def_skeleton_properties(cls, [](const PyMotion& self) -> const Skeleton& { return self.motion.skeleton; });
+  cls.def(
+      "write_bvh",
+      [](const PyMotion& self, const py::handle& path, bool overwrite) {
+        const std::string p = path_of(path);
+        py::gil_scoped_release unlocked;
+        write_bvh_file(self.motion, p, overwrite);
+      },
+      py::arg("path"), py::kw_only(), py::arg("overwrite") = false,
+      "Writes the motion as BVH text that reads back bit for bit. The file is written to a\n"
+      "temporary file beside `path` and renamed once complete; an existing file is replaced only\n"
+      "with overwrite=True (else FileExistsError).");
+  cls.def(
+      "world_positions",
+      [](const PyMotion& self, const py::handle& frames) {
+        return per_node(self, frames, 3, [&](const double* row, double* out) {
+          thread_local std::vector<offline::Vec3> pos;
+          offline::world_positions(self.motion.skeleton, row, pos);
+          for (size_t j = 0; j < pos.size(); ++j) std::copy(pos[j].begin(), pos[j].end(), out + 3 * j);
+        });
+      },
+      py::arg("frames") = py::none(),
+      "World position of every node by forward kinematics (the ground truth keyanim measures\n"
+      "errors with): float64 array frames.shape + (nodes, 3). frames: None (every frame), an int\n"
+      "or an array of ints (negative ones count from the end).");
+  cls.def(
+      "local_quaternions",
+      [](const PyMotion& self, const py::handle& frames) {
+        return per_node(self, frames, 4, [&](const double* row, double* out) {
+          for (const Joint& j : self.motion.skeleton.joints) {
+            const offline::Quat q = offline::local_quaternion(j, row);
+            std::copy(q.begin(), q.end(), out);
+            out += 4;
+          }
+        });
+      },
+      py::arg("frames") = py::none(),
+      "Each node's local rotation (its Euler channels in their order) as a unit quaternion\n"
+      "(x, y, z, w): float64 array frames.shape + (nodes, 4); the identity for End Sites.");
+  cls.def("__repr__", [](const PyMotion& self) {
+    return "<keyanim.Motion: " + std::to_string(self.motion.frame_count) + " frames, " +
+           std::to_string(self.motion.skeleton.joints.size()) + " nodes, " +
+           std::to_string(self.motion.channel_count()) + " channels>";
+  });
+
+  m.def("read_bvh", &read, py::arg("path"),
+        "Reads a BVH file into a Motion, exactly (every value bit for bit). Raises keyanim.Error\n"
+        "with file, line and column for malformed text, OSError when the file cannot be read.\n"
+        "Releases the GIL while reading.");
+  m.def(
+      "measure_error",
+      [](const PyMotion& original, const PyMotion& decoded) {
+        const offline::Motion& a = original.motion;
+        const offline::Motion& b = decoded.motion;
+        if (a.frame_count != b.frame_count || a.channel_count() != b.channel_count() ||
+            a.skeleton.joints.size() != b.skeleton.joints.size())
+          throw offline::Error(offline::ErrorKind::invalid_argument,
+                               "the motions differ in frames, channels or nodes: cannot compare them");
+        offline::ErrorReport report;
+        {
+          py::gil_scoped_release unlocked;
+          report = offline::measure_error(a, b);
+        }
+        return to_python(cli::error_json(a.skeleton, report));
+      },
+      py::arg("original"), py::arg("decoded"),
+      "World-space distance between two motions of the same skeleton and frame count, over every\n"
+      "joint and End Site and frame: a dict like the 'error' of the encode report (max, rms,\n"
+      "worst_joint, worst_frame, max_leaf_rotation_deg).");
+}
+
+}  // namespace keyanim::python

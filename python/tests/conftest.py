@@ -1,0 +1,213 @@
+"""Shared fixtures of the Python tests, and an independent reading of BVH and forward kinematics
+in plain Python/numpy (written from the BVH description and spec/FORMAT.md appendix B, not from
+keyanim's code), which the tests check the module against.
+
+Environment (set by CTest, python/CMakeLists.txt): PYTHONPATH holds the built module;
+KEYANIM_REPO_DIR the checkout (data/, tests/data/bvh); KEYANIM_CORPUS_DIR the shared corpus
+(tests marked `corpus` skip without it, and a run of corpus tests alone then exits 77, which
+CTest reports as skipped); KEYANIM_CLI the keyanim tool, for comparing reports with it.
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+REPO = Path(os.environ.get("KEYANIM_REPO_DIR", HERE.parent.parent))
+DATA = REPO / "data"
+FIXTURES = REPO / "tests" / "data" / "bvh"
+WALK = DATA / "cmu_02_01_walk.bvh"
+HOP = DATA / "cmu_131_03_hop.bvh"
+CORPUS = Path(os.environ.get("KEYANIM_CORPUS_DIR", REPO.parent / "shared" / "corpus"))
+CORPUS_SKIP = "keyanim-corpus-skip: %s not found" % CORPUS
+
+
+def corpus_files():
+    """Every .bvh of the shared corpus, sorted; empty without it."""
+    return sorted(CORPUS.rglob("*.bvh")) if CORPUS.is_dir() else []
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "corpus: needs the shared BVH corpus (KEYANIM_CORPUS_DIR)")
+
+
+def pytest_collection_modifyitems(config, items):
+    if CORPUS.is_dir():
+        return
+    for item in items:
+        if "corpus" in item.keywords:
+            item.add_marker(pytest.mark.skip(reason=CORPUS_SKIP))
+
+
+def pytest_sessionfinish(session, exitstatus):
+    # Every selected test skipped for want of the corpus: tell CTest "skipped" (77), not "passed".
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is None or exitstatus != 0:
+        return
+    skipped = reporter.stats.get("skipped", [])
+    ran = sum(len(reporter.stats.get(k, [])) for k in ("passed", "failed", "error"))
+    if skipped and not ran and not CORPUS.is_dir():
+        print("\n" + CORPUS_SKIP)
+        session.exitstatus = 77
+
+
+def cli(*args, check=True):
+    """Runs the keyanim tool (KEYANIM_CLI); skips the test when it was not built."""
+    tool = os.environ.get("KEYANIM_CLI")
+    if not tool or not os.path.exists(tool):
+        pytest.skip("the keyanim tool is not built (KEYANIM_CLI)")
+    r = subprocess.run([tool, *map(str, args)], capture_output=True, text=True, errors="surrogateescape")
+    if check and r.returncode != 0:
+        raise AssertionError("keyanim %s exited %d: %s" % (" ".join(map(str, args)), r.returncode, r.stderr))
+    return r
+
+
+def cli_json(*args):
+    return json.loads(cli(*args).stdout)
+
+
+# ---- An independent BVH reader: the hierarchy, then the MOTION numbers.
+
+class Bvh:
+    """names, parents, offsets (n, 3), end_site flags, channels [(node, 'Xrotation')...],
+    frame_count, frame_time, values (frames, channels) float64."""
+
+
+def parse_bvh(path):
+    text = Path(path).read_bytes().decode("latin-1")
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    b = Bvh()
+    b.names, b.parents, b.offsets, b.end_site, b.channels = [], [], [], [], []
+    stack, i = [], 0
+    while not lines[i].strip().upper().startswith("MOTION"):
+        words = lines[i].split()
+        i += 1
+        if not words:
+            continue
+        key = words[0].upper()
+        if key in ("ROOT", "JOINT") or (key == "END" and len(words) > 1 and words[1].upper() == "SITE"):
+            end = key == "END"
+            rest = lines[i - 1].strip()[len(words[0]):].strip()
+            if end:
+                rest = rest[len(words[1]):].strip()
+            b.names.append(rest.rstrip("{").strip())
+            b.parents.append(stack[-1] if stack and key != "ROOT" else -1)
+            b.offsets.append([0.0, 0.0, 0.0])
+            b.end_site.append(end)
+        elif key == "{":
+            stack.append(len(b.names) - 1)
+        elif key == "}":
+            stack.pop()
+        elif key == "OFFSET":
+            b.offsets[-1] = [float(v) for v in words[1:4]]
+        elif key == "CHANNELS":
+            b.channels += [(len(b.names) - 1, w) for w in words[2:2 + int(words[1])]]
+        if words[-1] == "{" and key != "{":
+            stack.append(len(b.names) - 1)
+    b.offsets = np.array(b.offsets, dtype=np.float64)
+    rest = [r for r in lines[i + 1:] if r.strip()]
+    b.frame_count = int(rest[0].split(":")[1])
+    b.frame_time = float(rest[1].split(":")[1])
+    rows = [r.split() for r in rest[2:]]
+    b.values = np.array([[float(v) for v in r] for r in rows], dtype=np.float64).reshape(len(rows), len(b.channels))
+    return b
+
+
+# ---- Independent forward kinematics (spec/FORMAT.md appendix B): R = R_1 R_2 R_3 over the
+# rotation channels in order, position channels replace OFFSET components, p = p_parent +
+# R_parent t.
+
+def _axis_matrices(axis, degrees):
+    a = np.radians(degrees)
+    c, s = np.cos(a), np.sin(a)
+    m = np.zeros(degrees.shape + (3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m[..., axis, axis] = 1
+    m[..., i, i], m[..., i, j], m[..., j, i], m[..., j, j] = c, -s, s, c
+    return m
+
+
+def local_rotations(bvh, values):
+    """(frames, nodes, 3, 3) local rotation matrices."""
+    n = len(bvh.names)
+    rot = np.tile(np.eye(3), (values.shape[0], n, 1, 1))
+    for col, (node, name) in enumerate(bvh.channels):
+        if name.lower().endswith("rotation"):
+            axis = "xyz".index(name[0].lower())
+            rot[:, node] = rot[:, node] @ _axis_matrices(axis, values[:, col])
+    return rot
+
+
+def local_translations(bvh, values):
+    t = np.tile(bvh.offsets, (values.shape[0], 1, 1))
+    for col, (node, name) in enumerate(bvh.channels):
+        if name.lower().endswith("position"):
+            t[:, node, "xyz".index(name[0].lower())] = values[:, col]
+    return t
+
+
+def world_positions(bvh, values):
+    """(frames, nodes, 3)."""
+    rot, t = local_rotations(bvh, values), local_translations(bvh, values)
+    world_r, world_p = np.empty_like(rot), np.empty_like(t)
+    for j, p in enumerate(bvh.parents):
+        if p < 0:
+            world_r[:, j], world_p[:, j] = rot[:, j], t[:, j]
+        else:
+            world_r[:, j] = world_r[:, p] @ rot[:, j]
+            world_p[:, j] = world_p[:, p] + np.einsum("fij,fj->fi", world_r[:, p], t[:, j])
+    return world_p
+
+
+def quaternion_matrices(q):
+    """(..., 4) quaternions (x, y, z, w) -> (..., 3, 3) rotation matrices."""
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+def skeleton_size(bvh):
+    """Largest side of the rest pose's bounding box (OFFSETs alone)."""
+    rest = np.zeros_like(bvh.offsets)
+    for j, p in enumerate(bvh.parents):
+        rest[j] = bvh.offsets[j] + (rest[p] if p >= 0 else 0)
+    return float((rest.max(axis=0) - rest.min(axis=0)).max())
+
+
+@pytest.fixture(scope="session")
+def keyanim():
+    import keyanim as module
+    return module
+
+
+@pytest.fixture(scope="session")
+def walk(keyanim):
+    return keyanim.read_bvh(WALK)
+
+
+@pytest.fixture(scope="session")
+def walk_bvh():
+    return parse_bvh(WALK)
+
+
+@pytest.fixture(scope="session")
+def walk_encoded(keyanim, walk):
+    return keyanim.encode(walk)
+
+
+@pytest.fixture(scope="session")
+def walk_clip(keyanim, walk_encoded):
+    return keyanim.Clip(walk_encoded[0])
+
+
+@pytest.fixture
+def python():
+    return sys.executable

@@ -1,0 +1,270 @@
+"""keyanim.Clip: loading from paths and bytes, sampling against spec/FORMAT.md appendix A
+evaluated independently in numpy binary32, poses against independent forward kinematics,
+info and decoding against the keyanim tool, and damaged files."""
+
+import os
+import pathlib
+import warnings
+
+import numpy as np
+import pytest
+
+from conftest import HOP, WALK, cli, cli_json, corpus_files, local_rotations, parse_bvh, quaternion_matrices, world_positions
+
+F = np.float32
+
+
+def appendix_a(frames, values, interpolation, tension, rule, x):
+    """The value of one channel at frame position x (binary64), operation for operation in
+    binary32 as spec/FORMAT.md appendix A states it."""
+    n = len(frames)
+    if n == 0:
+        return F(0)
+    f = F(x)
+    K = [F(k) for k in frames]
+    if n == 1 or not f > K[0]:
+        return values[0]
+    if f >= K[-1]:
+        return values[-1]
+    j = max(i for i in range(n - 1) if K[i] <= f)
+    if f == K[j]:
+        return values[j]
+    u = (f - K[j]) / (K[j + 1] - K[j])
+    p0, p1 = values[j], values[j + 1]
+    if interpolation == "linear":
+        return p0 + u * (p1 - p0)
+    pm, p2 = values[max(j - 1, 0)], values[min(j + 2, n - 1)]
+    s = (F(1) - F(tension)) * F(0.5)
+    a0 = a1 = F(1)
+    if rule == "step_adjusted":
+        length = F(int(frames[j + 1]) - int(frames[j]))
+        if j > 0:
+            a0 = F(2) * length / (F(int(frames[j]) - int(frames[j - 1])) + length)
+        if j + 2 < n:
+            a1 = F(2) * length / (length + F(int(frames[j + 2]) - int(frames[j + 1])))
+    m0 = s * a0 * (p1 - pm)
+    m1 = s * a1 * (p2 - p0)
+    u2 = u * u
+    u3 = u2 * u
+    h01 = F(-2) * u3 + F(3) * u2
+    h10 = u3 - F(2) * u2 + u
+    h11 = u3 - u2
+    return ((p0 + h01 * (p1 - p0)) + h10 * m0) + h11 * m1
+
+
+def test_load_from_path_and_bytes(keyanim, walk_encoded, tmp_path):
+    data = walk_encoded[0]
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(data)
+    clips = [keyanim.Clip(data), keyanim.Clip(bytearray(data)), keyanim.Clip(memoryview(data)),
+             keyanim.Clip(str(path)), keyanim.Clip(path)]  # (bytes are the file itself, not a path)
+    for c in clips:
+        assert (c.frame_count, c.channel_count, c.total_keys) == (344, 96, walk_encoded[1]["keys"])
+        assert np.array_equal(c.sample_frames([0, 17.25]), clips[0].sample_frames([0, 17.25]))
+    assert clips[0].file is None and clips[3].file == str(path)
+    assert clips[0].frame_time == 0.0083333 and clips[0].duration == pytest.approx(343 * 0.0083333)
+    assert "tolerance_units" in clips[0].encoder_notes
+    assert clips[0].memory_bytes > 0
+    assert repr(clips[0]).startswith("<keyanim.Clip: 344 frames, 38 nodes, 96 channels")
+
+
+def test_skeleton_properties_are_the_motions(walk, walk_clip):
+    assert walk_clip.joint_names == walk.joint_names
+    assert walk_clip.channel_names == walk.channel_names
+    assert np.array_equal(walk_clip.parents, walk.parents)
+    assert np.array_equal(walk_clip.offsets, walk.offsets)
+    assert np.array_equal(walk_clip.is_end_site, walk.is_end_site)
+
+
+def test_sampling_is_appendix_a(walk_clip):
+    rule = walk_clip.info["tangent_rule"]
+    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343, 400, -3])
+    got = walk_clip.sample_frames(positions)
+    assert got.dtype == np.float32 and got.shape == (10, 96)
+    for c in range(walk_clip.channel_count):
+        info = walk_clip.channel(c)
+        frames, values = walk_clip.channel_keys(c)
+        assert len(frames) == info["key_count"] and frames.dtype == np.uint32 and values.dtype == np.float32
+        want = [appendix_a(frames, values, info["interpolation"], info["tension"], rule, x) for x in positions]
+        assert np.array_equal(got[:, c], np.array(want, dtype=F)), walk_clip.channel_names[c]
+        # At its keys a channel is its keys' values exactly.
+        assert np.array_equal(walk_clip.sample_frames(frames.astype(np.float64))[:, c], values)
+
+
+def test_times_and_frames_agree(walk_clip):
+    ft = walk_clip.frame_time
+    frames = np.array([0.0, 2.0, 10.5, 343.0])
+    assert np.array_equal(walk_clip.sample(frames * ft), walk_clip.sample_frames(frames))
+    assert walk_clip.sample(0.5).shape == (96,)
+    assert walk_clip.sample([[0.1, 0.2], [0.3, 0.4]]).shape == (2, 2, 96)
+    assert walk_clip.sample([]).shape == (0, 96)
+
+
+def test_sample_matches_the_tool(walk_clip, walk_encoded, tmp_path):
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(walk_encoded[0])
+    tool = cli_json("sample", path, "--frame", "100.25", "--json")
+    row = walk_clip.sample_frames(100.25)
+    names = walk_clip.channel_names
+    values = {}
+    for joint in tool["joints"]:
+        for key, v in joint.items():
+            if key != "name":
+                values[joint["name"] + ":" + key] = v
+    assert [values[n] for n in names] == [float(v) for v in row]
+
+
+def test_local_transforms_match_independent_rotations(walk, walk_bvh, walk_clip):
+    frames = np.arange(0, 344, 7)
+    q, t = walk_clip.local_transforms(frames=frames.astype(np.float64))
+    assert q.shape == (len(frames), 38, 4) and t.shape == (len(frames), 38, 3) and q.dtype == np.float32
+    decoded = walk_clip.sample_frames(frames).astype(np.float64)
+    np.testing.assert_allclose(np.linalg.norm(q, axis=-1), 1.0, atol=1e-6)
+    np.testing.assert_allclose(quaternion_matrices(q.astype(np.float64)), local_rotations(walk_bvh, decoded), atol=2e-6)
+    from conftest import local_translations
+    np.testing.assert_allclose(t, local_translations(walk_bvh, decoded), rtol=1e-6, atol=1e-5)
+    # By time, the same; and 'add' adds the OFFSET to the root's position channels.
+    q2, t2 = walk_clip.local_transforms(frames * walk_clip.frame_time)
+    np.testing.assert_allclose(q2, q, atol=1e-6)
+    _, added = walk_clip.local_transforms(frames=frames.astype(np.float64), position_reading="add")
+    np.testing.assert_allclose(added[:, 0], t[:, 0] + walk.offsets[0], atol=1e-5)
+    # Quaternions are continuous from frame to frame (no sign flips).
+    qs = walk_clip.local_transforms(frames=np.arange(344.0))[0]
+    assert (np.sum(qs[1:] * qs[:-1], axis=-1) > 0).all()
+
+
+def test_world_positions_match_independent_fk(walk_bvh, walk_clip):
+    frames = np.arange(0, 344, 5).astype(np.float64)
+    got = walk_clip.world_positions(frames=frames)
+    assert got.shape == (len(frames), 38, 3) and got.dtype == np.float32
+    want = world_positions(walk_bvh, walk_clip.sample_frames(frames).astype(np.float64))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-4)
+    np.testing.assert_allclose(walk_clip.world_positions(frames * walk_clip.frame_time), got, atol=1e-5)
+
+
+def test_info_is_the_tools(walk_clip, walk_encoded, tmp_path):
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(walk_encoded[0])
+    import keyanim
+    from_file = keyanim.Clip(path).info
+    assert from_file == cli_json("info", path, "--json")
+    in_memory = walk_clip.info
+    assert in_memory["file"] is None and {k: v for k, v in in_memory.items() if k != "file"} == \
+        {k: v for k, v in from_file.items() if k != "file"}
+    assert in_memory["format"] == "kanim" and in_memory["version"] == keyanim.format_version
+
+
+def test_to_motion(keyanim, walk_clip, walk_encoded, tmp_path):
+    m = walk_clip.to_motion()
+    assert m.frame_count == 344 and m.source is None
+    assert np.array_equal(m.channels, walk_clip.sample_frames(np.arange(344.0)).astype(np.float64))
+    m30 = walk_clip.to_motion(fps=30)
+    assert m30.frame_count == int(np.floor(343 * 0.0083333 * 30 + 1e-6)) + 1
+    assert m30.frame_time == pytest.approx(1 / 30)
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(walk_encoded[0])
+    cli("decode", path, "--fps", "30", "-o", tmp_path / "walk30.bvh")
+    assert np.array_equal(keyanim.read_bvh(tmp_path / "walk30.bvh").channels, m30.channels)
+    for bad in (-1, float("nan"), float("inf")):
+        with pytest.raises(keyanim.Error) as info:
+            walk_clip.to_motion(fps=bad)
+        assert info.value.kind == "invalid_argument"
+
+
+def test_from_motion_keeps_every_frame(keyanim, walk, tmp_path):
+    clip = keyanim.Clip.from_motion(walk)
+    assert clip.total_keys == 344 * 96 - 20 * 344  # zero channels need no keys
+    got = clip.sample_frames(np.arange(344.0)).astype(np.float64)
+    diff = (got - walk.channels + 180.0) % 360.0 - 180.0  # angles unwrapped: compare modulo 360
+    bound = np.abs(walk.channels).max(axis=0) * 2.0 ** -23  # half the channel's float32 step, and rounding
+    assert (np.abs(diff) <= bound + 1e-12).all()
+    # Between frames: Catmull-Rom through the source frames.
+    c = walk.channel_names.index("LeftUpLeg:Xrotation")
+    f, v = clip.channel_keys(c)
+    assert np.array_equal(f, np.arange(344))
+    assert clip.channel(c) == {"interpolation": "cardinal", "tension": 0.0, "key_count": 344}
+    assert clip.sample_frames(10.5)[c] == appendix_a(f, v, "cardinal", 0.0, "step_adjusted", 10.5)
+
+
+def test_argument_errors(keyanim, walk_clip):
+    with pytest.raises(ValueError, match="NaN"):
+        walk_clip.sample([0.0, float("nan")])
+    with pytest.raises(TypeError):
+        walk_clip.sample("soon")
+    with pytest.raises(TypeError):
+        walk_clip.local_transforms([0.0], frames=[0.0])
+    with pytest.raises(TypeError):
+        walk_clip.world_positions()
+    with pytest.raises(ValueError, match="position_reading"):
+        walk_clip.local_transforms([0.0], position_reading="sideways")
+    with pytest.raises(IndexError):
+        walk_clip.channel_keys(96)
+    with pytest.raises(IndexError):
+        walk_clip.channel(-97)
+    assert walk_clip.channel(-1) == walk_clip.channel(95)
+    with pytest.raises(TypeError):
+        keyanim.Clip(3.5)
+
+
+def test_damaged_files_name_section_and_offset(keyanim, walk_encoded, tmp_path):
+    data = walk_encoded[0]
+    path = tmp_path / "bad.kanim"
+    cases = {
+        "truncated": data[: len(data) // 2],
+        "bad_signature": b"\x89KAX" + data[4:],
+        "checksum_mismatch": data[:-1] + bytes([data[-1] ^ 1]),
+        "trailing_bytes": data + b"\0",
+        "empty": b"",
+    }
+    for name, bad in cases.items():
+        path.write_bytes(bad)
+        with pytest.raises(keyanim.Error) as info:
+            keyanim.Clip(path)
+        e = info.value
+        assert e.kind == "malformed" and e.file == str(path) and e.section
+        assert str(e) == "%s: section %s, offset %d (0x%X): %s: %s" % (path, e.section, e.offset, e.offset, e.status, e.message)
+        if name != "empty":
+            assert e.status == name
+        # The tool names the same place.
+        r = cli("verify", path, check=False)
+        assert r.returncode == 2
+        if name not in ("bad_signature", "empty"):  # (which the tool refuses before loading)
+            assert "section %s, offset %d (0x%X)" % (e.section, e.offset, e.offset) in r.stderr
+        with pytest.raises(keyanim.Error) as from_bytes:
+            keyanim.Clip(bad)
+        assert from_bytes.value.file is None and from_bytes.value.offset == e.offset
+    with pytest.raises(FileNotFoundError):
+        keyanim.Clip(tmp_path / "missing.kanim")
+    with pytest.raises(IsADirectoryError):
+        keyanim.Clip(tmp_path)
+
+
+def test_unsupported_version(keyanim, walk_encoded):
+    data = bytearray(walk_encoded[0])
+    data[8] = 99  # major version (u16 little-endian after the 8-byte signature)
+    with pytest.raises(keyanim.Error) as info:
+        keyanim.Clip(bytes(data))
+    assert info.value.kind == "unsupported" and info.value.status == "unsupported_version"
+
+
+@pytest.mark.corpus
+@pytest.mark.parametrize("path", corpus_files() or [None], ids=lambda p: p.name if p else "none")
+def test_corpus_clips(keyanim, path, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = keyanim.read_bvh(path)
+    data, report = keyanim.encode(m, error="0.5%")
+    clip = keyanim.Clip(data)
+    n = clip.frame_count
+    positions = np.linspace(0, max(n - 1, 0), 41)
+    rows = clip.sample_frames(positions)
+    for c in range(0, clip.channel_count, 7):
+        info = clip.channel(c)
+        f, v = clip.channel_keys(c)
+        want = [appendix_a(f, v, info["interpolation"], info["tension"], clip.info["tangent_rule"], x) for x in positions]
+        assert np.array_equal(rows[:, c], np.array(want, dtype=F))
+    bvh = parse_bvh(path)
+    want = world_positions(bvh, rows.astype(np.float64))
+    size = max(report["tolerance"] / 0.005, 1.0)
+    np.testing.assert_allclose(clip.world_positions(frames=positions), want, rtol=0, atol=1e-5 * size)
+    assert np.array_equal(clip.to_motion().channels, clip.sample_frames(np.arange(float(n))).astype(np.float64))
