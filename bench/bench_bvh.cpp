@@ -96,15 +96,13 @@ int main(int argc, char** argv) {
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 
     keyanim::offline::Motion motion;
-    keyanim::offline::BvhError err;
-    if (!keyanim::offline::read_bvh(text, path.string(), motion, err)) {
-      std::fprintf(stderr, "bench_bvh: %s\n", err.to_string().c_str());
+    try {
+      motion = keyanim::offline::read_bvh(text, path.string());
+    } catch (const keyanim::offline::Error& e) {
+      std::fprintf(stderr, "bench_bvh: %s\n", e.what());
       return 1;
     }
-    const double parse_s = median_seconds(runs, [&] {
-      keyanim::offline::Motion m;
-      keyanim::offline::read_bvh(text, path.string(), m, err);
-    });
+    const double parse_s = median_seconds(runs, [&] { keyanim::offline::read_bvh(text, path.string()); });
     std::string written;
     const double write_s = median_seconds(runs, [&] { written = keyanim::offline::write_bvh(motion); });
 

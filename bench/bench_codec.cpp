@@ -83,7 +83,12 @@ RunResult run(const offline::Motion& m, offline::EncodeSettings s) {
   s.threads = 1;
   const double t0 = cpu_ms();
   offline::EncodeResult enc;
-  if (!offline::encode(m, s, enc, r.error)) return r;
+  try {
+    enc = offline::encode(m, s);
+  } catch (const offline::Error& e) {
+    r.error = e.what();
+    return r;
+  }
   const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, s.zstd_level);
   r.encode_ms = cpu_ms() - t0;
   // Measure on what a decoder makes of the bytes, not on the encoder's own view.
@@ -93,9 +98,7 @@ RunResult run(const offline::Motion& m, offline::EncodeSettings s) {
     r.error = "load failed: " + info.detail;
     return r;
   }
-  offline::Motion decoded;
-  if (!offline::decode_motion(clip, {}, decoded, r.error)) return r;
-  const offline::ErrorReport e = offline::measure_error(m, decoded);
+  const offline::ErrorReport e = offline::measure_error(m, offline::decode_motion(clip));
   r.bytes = bytes.size(), r.keys = enc.total_keys, r.max_error = e.max_error, r.rms_error = e.rms_error;
   r.max_error_replace = e.reading_max[size_t(PositionReading::replace)];
   r.worst_point = offline::point_name(m.skeleton, e.worst_joint, e.worst_point);
@@ -111,12 +114,7 @@ double encode_wall_ms(const offline::Motion& m, unsigned threads, int reps, size
     offline::EncodeSettings s;
     s.threads = threads;
     const auto t0 = Clock::now();
-    offline::EncodeResult enc;
-    std::string error;
-    if (!offline::encode(m, s, enc, error)) {
-      std::cerr << "bench_codec: " << error << "\n";
-      return 0.0;
-    }
+    const offline::EncodeResult enc = offline::encode(m, s);
     bytes = offline::write_kanim(enc.clip, s.zstd_level, threads).size();
     best = std::min(best, ms_since(t0));
   }
@@ -125,21 +123,8 @@ double encode_wall_ms(const offline::Motion& m, unsigned threads, int reps, size
 
 // The child of the memory measurement: what `keyanim encode` holds, in a fresh process.
 int rss_child(const std::string& path) {
-  offline::Motion m;
-  {
-    const std::string text = read_file(path);
-    offline::BvhError err;
-    if (!offline::read_bvh(text, path, m, err)) {
-      std::cerr << err.to_string() << "\n";
-      return 1;
-    }
-  }  // the text is freed before encoding, as the CLI does
-  offline::EncodeResult enc;
-  std::string error;
-  if (!offline::encode(m, {}, enc, error)) {
-    std::cerr << "bench_codec: " << error << "\n";
-    return 1;
-  }
+  offline::Motion m = offline::read_bvh(read_file(path), path);  // the text is freed before encoding, as the CLI does
+  const offline::EncodeResult enc = offline::encode(m, {});
   m = {};  // and the motion before writing (zstd's tables at level 19 are tens of MB)
   const size_t bytes = offline::write_kanim(enc.clip, 19).size();
   std::cout << bytes << "\n";
@@ -166,15 +151,12 @@ double child_peak_rss(const char* self, const std::string& path) {
 nlohmann::json long_clips(const char* self, const fs::path& corpus, int reps) {
   const fs::path base = corpus / "cmu" / "assimp__01_01.bvh";
   const std::string text = read_file(base);
-  offline::Motion m;
-  offline::BvhError err;
-  if (!offline::read_bvh(text, base.string(), m, err)) return {{"error", err.to_string()}};
+  const offline::Motion m = offline::read_bvh(text, base.string());
   nlohmann::json out = {{"source", "cmu/assimp__01_01.bvh"}};
   const fs::path dir = fs::temp_directory_path();
   {
     const uint32_t frames = 4 * m.frame_count;
-    offline::Motion longer;
-    if (!offline::read_bvh(bench::long_bvh_text(text, m, frames), "long", longer, err)) return {{"error", err.to_string()}};
+    const offline::Motion longer = offline::read_bvh(bench::long_bvh_text(text, m, frames), "long");
     size_t b1 = 0, b2 = 0;
     const double one = encode_wall_ms(longer, 1, reps, b1), two = encode_wall_ms(longer, 2, reps, b2);
     out["speedup"] = {{"frames", frames}, {"ms_1thread", one}, {"ms_2threads", two}, {"same_bytes", b1 == b2},
@@ -196,7 +178,7 @@ nlohmann::json long_clips(const char* self, const fs::path& corpus, int reps) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bench_main(int argc, char** argv) {
   std::vector<std::string> tolerances{"0.05%", "0.5%"};
   std::string filter;
   bool linear = true, fit = false, long_runs = true;
@@ -207,9 +189,7 @@ int main(int argc, char** argv) {
     if (a == "--write-long" && i + 2 < argc) {
       const fs::path base = fs::path(KEYANIM_CORPUS_DIR) / "cmu" / "assimp__01_01.bvh";
       const std::string text = read_file(base);
-      offline::Motion m;
-      offline::BvhError err;
-      if (!offline::read_bvh(text, base.string(), m, err)) return std::cerr << err.to_string() << "\n", 1;
+      const offline::Motion m = offline::read_bvh(text, base.string());
       std::ofstream(argv[i + 2], std::ios::binary) << bench::long_bvh_text(text, m, uint32_t(std::stoul(argv[i + 1])));
       return 0;
     }
@@ -256,15 +236,15 @@ int main(int argc, char** argv) {
     std::ifstream in(p, std::ios::binary);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     offline::Motion m;
-    offline::BvhError err;
     std::vector<double> parse_ms;
-    for (int rep = 0; rep < 3; ++rep) {
-      const double t0 = cpu_ms();
-      if (!offline::read_bvh(text, p.string(), m, err)) break;
-      parse_ms.push_back(cpu_ms() - t0);
-    }
-    if (parse_ms.size() != 3) {
-      out["files"].push_back({{"file", p.filename().string()}, {"error", err.to_string()}});
+    try {
+      for (int rep = 0; rep < 3; ++rep) {
+        const double t0 = cpu_ms();
+        m = offline::read_bvh(text, p.string());
+        parse_ms.push_back(cpu_ms() - t0);
+      }
+    } catch (const offline::Error& e) {
+      out["files"].push_back({{"file", p.filename().string()}, {"error", e.what()}});
       continue;
     }
     std::sort(parse_ms.begin(), parse_ms.end());
@@ -359,4 +339,13 @@ int main(int argc, char** argv) {
   out["targets"] = {{"encode_over_parse_1thread", "<= 20"}, {"speedup_2threads", ">= 1.7"}, {"peak_rss_over_bvh_bytes", "<= 3"}};
   std::cout << out.dump(1) << "\n";
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return bench_main(argc, argv);
+  } catch (const offline::Error& e) {  // a corpus file or a long clip the library refused
+    std::cerr << "bench_codec: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -107,8 +107,11 @@ nlohmann::json measure(const Motion& m, bool speed) {
   keyanim::offline::EncodeSettings settings;
   settings.threads = 0;
   keyanim::offline::EncodeResult result;
-  std::string why;
-  if (!keyanim::offline::encode(m, settings, result, why)) return {{"error", why}};
+  try {
+    result = keyanim::offline::encode(m, settings);
+  } catch (const keyanim::offline::Error& e) {
+    return {{"error", e.what()}};
+  }
   const std::vector<uint8_t> bytes = keyanim::offline::write_kanim(result.clip);
   Clip clip;
   if (Clip::load(bytes, clip) != keyanim::Status::ok) return {{"error", "load failed"}};
@@ -201,10 +204,13 @@ nlohmann::json measure(const Motion& m, bool speed) {
 }
 
 bool read(const fs::path& p, Motion& m) {
-  keyanim::offline::BvhError err;
-  if (keyanim::offline::read_bvh_file(p.string(), m, err)) return true;
-  std::cerr << err.to_string() << "\n";
-  return false;
+  try {
+    m = keyanim::offline::read_bvh_file(p.string());
+    return true;
+  } catch (const keyanim::offline::Error& e) {
+    std::cerr << e.what() << "\n";
+    return false;
+  }
 }
 
 }  // namespace

@@ -224,9 +224,7 @@ void register_clip(py::module_& m) {
         if (!fps.is_none()) options.fps = fps.cast<double>();
         auto out = std::make_shared<PyMotion>();
         py::gil_scoped_release unlocked;
-        std::string why;
-        if (!offline::decode_motion(c.clip, options, out->motion, why))
-          throw offline::Error(offline::ErrorKind::invalid_argument, why);
+        out->motion = offline::decode_motion(c.clip, options);
         return out;
       },
       py::arg("fps") = py::none(),

@@ -47,8 +47,11 @@ Clip dense_clip(const offline::Motion& motion) {
     const Joint& j = motion.skeleton.joints[node];
     enc.channels[c] = keyed_everywhere(motion.channel(c), is_rotation(j.channels[c - j.first_channel]));
   }
-  if (const std::string why = offline::validate_encoded_clip(enc); !why.empty())
-    throw offline::Error(offline::ErrorKind::malformed, "cannot be held as a clip: " + why);
+  try {
+    offline::validate_encoded_clip(enc);
+  } catch (const offline::Error& e) {
+    throw offline::Error(offline::ErrorKind::malformed, "cannot be held as a clip: " + e.message());
+  }
   return offline::to_clip(enc);
 }
 

@@ -80,7 +80,7 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
                            "' (settings: tension, level, threads, tangent_rule, allow_linear, force_linear)");
     }
   }
-  if (const std::string why = s.validate(); !why.empty()) invalid(why);
+  s.validate();
 }
 
 py::tuple encode(const PyMotion& m, const py::handle& error, const py::handle& keys, const py::kwargs& kwargs) {
@@ -95,11 +95,8 @@ py::tuple encode(const PyMotion& m, const py::handle& error, const py::handle& k
   {
     py::gil_scoped_release unlocked;
     const auto t0 = std::chrono::steady_clock::now();
-    std::string why;
-    if (!offline::encode(m.motion, settings, result, why)) throw offline::Error(offline::ErrorKind::malformed, why);
+    result = offline::encode(m.motion, settings);
     bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
-    if (bytes.empty())
-      throw offline::Error(offline::ErrorKind::malformed, "cannot be stored: " + offline::validate_encoded_clip(result.clip));
     encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   py::dict report = to_python(cli::encode_summary("", "", m.motion, m.bvh_bytes.value_or(0), settings, result,

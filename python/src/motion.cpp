@@ -1,12 +1,12 @@
 // keyanim.read_bvh, keyanim.Motion (its channels as a numpy view, BVH writing, forward
 // kinematics) and keyanim.measure_error.
-#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
-#include <random>
 
 #include "common.h"
 #include "keyanim/offline/bvh.h"
@@ -25,16 +25,7 @@ PyMotion read(const py::handle& path_arg) {
   std::vector<std::string> warnings;
   {
     py::gil_scoped_release unlocked;
-    offline::BvhError err;
-    if (!offline::read_bvh_file(*m.source, m.motion, err, &warnings)) {
-      if (err.line == 0) {  // an I/O failure: open again for its errno
-        std::FILE* f = std::fopen(m.source->c_str(), "rb");
-        if (f == nullptr) throw offline::Error::io(err.file, "cannot open file", errno);
-        std::fclose(f);
-        if (std::filesystem::is_directory(*m.source)) throw offline::Error::io(err.file, "cannot read file", EISDIR);
-      }
-      throw offline::Error::bvh(err.file, err.line, err.column, err.message);
-    }
+    m.motion = offline::read_bvh_file(*m.source, &warnings);
     std::error_code ec;
     const auto size = std::filesystem::file_size(*m.source, ec);
     if (!ec) m.bvh_bytes = size;
@@ -177,18 +168,12 @@ void register_motion(py::module_& m) {
   m.def(
       "measure_error",
       [](const PyMotion& original, const PyMotion& decoded) {
-        const offline::Motion& a = original.motion;
-        const offline::Motion& b = decoded.motion;
-        if (a.frame_count != b.frame_count || a.channel_count() != b.channel_count() ||
-            a.skeleton.joints.size() != b.skeleton.joints.size())
-          throw offline::Error(offline::ErrorKind::invalid_argument,
-                               "the motions differ in frames, channels or nodes: cannot compare them");
         offline::ErrorReport report;
         {
           py::gil_scoped_release unlocked;
-          report = offline::measure_error(a, b);
+          report = offline::measure_error(original.motion, decoded.motion);
         }
-        return to_python(cli::error_json(a.skeleton, report));
+        return to_python(cli::error_json(original.motion.skeleton, report));
       },
       py::arg("original"), py::arg("decoded"),
       "World-space distance between two motions of the same skeleton and frame count, over every\n"

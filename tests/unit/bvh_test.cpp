@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <array>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -20,7 +21,8 @@
 
 using keyanim::ChannelType;
 using keyanim::Joint;
-using keyanim::offline::BvhError;
+using keyanim::offline::Error;
+using keyanim::offline::ErrorKind;
 using keyanim::offline::BvhReadOptions;
 using keyanim::offline::Motion;
 using keyanim::offline::read_bvh;
@@ -44,29 +46,22 @@ std::string slurp(const std::string& path) {
 }
 
 Motion read_good(const std::string& name, std::vector<std::string>* warnings = nullptr) {
-  Motion m;
-  BvhError e;
-  const bool ok = read_bvh_file(fixture(name), m, e, warnings);
-  REQUIRE_MESSAGE(ok, e.to_string());
-  return m;
+  return read_bvh_file(fixture(name), warnings);
 }
 
-BvhError read_bad_text(std::string_view text, const BvhReadOptions& options = {}) {
-  Motion m;
-  BvhError e;
-  const bool ok = read_bvh(text, "text.bvh", m, e, nullptr, options);
-  REQUIRE_FALSE(ok);
-  CHECK(m.skeleton.joints.empty());  // failure leaves the output empty
-  CHECK(m.values.empty());
-  return e;
+// The error reading `text` throws (the test fails if it does not).
+Error read_bad_text(std::string_view text, const BvhReadOptions& options = {}) {
+  try {
+    read_bvh(text, "text.bvh", nullptr, options);
+  } catch (const Error& e) {
+    return e;
+  }
+  FAIL("read_bvh accepted the text");
+  return Error(ErrorKind::invalid_argument, "");
 }
 
 Motion read_good_text(std::string_view text, std::vector<std::string>* warnings = nullptr) {
-  Motion m;
-  BvhError e;
-  const bool ok = read_bvh(text, "text.bvh", m, e, warnings);
-  REQUIRE_MESSAGE(ok, e.to_string());
-  return m;
+  return read_bvh(text, "text.bvh", warnings);
 }
 
 void check_joint(const Joint& j, const std::string& name, int parent, std::array<double, 3> offset,
@@ -80,11 +75,12 @@ void check_joint(const Joint& j, const std::string& name, int parent, std::array
   CHECK(j.first_channel == first_channel);
 }
 
-void check_error(const BvhError& e, uint32_t line, uint32_t column, const std::string& part) {
-  INFO(e.to_string());
-  CHECK(e.line == line);
-  CHECK(e.column == column);
-  CHECK(e.message.find(part) != std::string::npos);
+void check_error(const Error& e, uint32_t line, uint32_t column, const std::string& part) {
+  INFO(e.what());
+  CHECK(e.line() == line);
+  CHECK(e.column() == column);
+  CHECK(e.message().find(part) != std::string::npos);
+  CHECK(e.section().empty());
 }
 
 // The skeleton of zero_frames.bvh and one_frame.bvh.
@@ -265,13 +261,16 @@ TEST_CASE("bad fixtures report the exact place") {
   };
   for (const Case& c : cases) {
     INFO(c.file);
-    Motion m;
-    BvhError e;
-    REQUIRE_FALSE(read_bvh_file(fixture(c.file), m, e));
-    CHECK(e.file == fixture(c.file));
-    check_error(e, c.line, c.column, c.message);
-    CHECK(e.to_string() == fixture(c.file) + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) + ": " +
-                               e.message);
+    try {
+      read_bvh_file(fixture(c.file));
+      FAIL("accepted");
+    } catch (const Error& e) {
+      CHECK(e.file() == fixture(c.file));
+      CHECK(e.kind() == ErrorKind::malformed);
+      check_error(e, c.line, c.column, c.message);
+      CHECK(std::string(e.what()) == fixture(c.file) + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) +
+                                         ": " + e.message());
+    }
   }
 }
 
@@ -413,6 +412,7 @@ TEST_CASE("limits are enforced") {
   BvhReadOptions joints_limit;
   joints_limit.max_joints = 2;
   check_error(read_bad_text(one_frame, joints_limit), 10, 3, "expected at most 2 nodes (max_joints), found more");
+  CHECK(read_bad_text(one_frame, joints_limit).kind() == ErrorKind::limit);
 
   const std::string more = slurp(fixture("frames_more_lines.bvh"));  // Frames: 2, three lines
   BvhReadOptions frames_limit;
@@ -420,6 +420,7 @@ TEST_CASE("limits are enforced") {
   check_error(read_bad_text(more, frames_limit), 12, 9, "expected at most 1 frames (max_frames), found 2");
   frames_limit.max_frames = 2;
   check_error(read_bad_text(more, frames_limit), 16, 1, "expected at most 2 motion lines (max_frames), found more");
+  CHECK(read_bad_text(more, frames_limit).kind() == ErrorKind::limit);
 
   // The default limit, and a huge declared count that the data does not back.
   check_error(read_bad_text(std::string(kSmallHead) + "Frames: 99999999999\nFrame Time: 1\n1 2 3\n"), 12, 9,
@@ -428,18 +429,28 @@ TEST_CASE("limits are enforced") {
               "expected 16000000 motion lines (Frames: 16000000), found 1");
 }
 
-TEST_CASE("read_bvh_file reports I/O errors at line 0") {
-  Motion m;
-  BvhError e;
+TEST_CASE("read_bvh_file reports I/O errors with errno, at line 0") {
   const std::string path = fixture("does_not_exist.bvh");
-  REQUIRE_FALSE(read_bvh_file(path, m, e));
-  CHECK(e.file == path);
-  CHECK(e.line == 0);
-  CHECK(e.column == 0);
-  CHECK(e.message.find("No such file or directory") != std::string::npos);
-  REQUIRE_FALSE(read_bvh_file(KEYANIM_TEST_DATA_DIR, m, e));  // a directory cannot be read
-  CHECK(e.line == 0);
-  CHECK(e.message.find("Is a directory") != std::string::npos);
+  try {
+    read_bvh_file(path);
+    FAIL("accepted");
+  } catch (const Error& e) {
+    CHECK(e.kind() == ErrorKind::io);
+    CHECK(e.file() == path);
+    CHECK(e.line() == 0);
+    CHECK(e.column() == 0);
+    CHECK(e.system_error() == ENOENT);
+    CHECK(e.message().find("No such file or directory") != std::string::npos);
+    CHECK(std::string(e.what()) == path + ": " + e.message());
+  }
+  try {
+    read_bvh_file(KEYANIM_TEST_DATA_DIR);  // a directory cannot be read
+    FAIL("accepted");
+  } catch (const Error& e) {
+    CHECK(e.line() == 0);
+    CHECK(e.system_error() == EISDIR);
+    CHECK(e.message().find("Is a directory") != std::string::npos);
+  }
 }
 
 TEST_CASE("writer output of canonical fixtures is byte-identical to the file") {
@@ -456,9 +467,7 @@ TEST_CASE("writer round trip on every good fixture") {
     INFO(name);
     const Motion m = read_good(name);
     const std::string text = write_bvh(m);
-    Motion back;
-    BvhError e;
-    REQUIRE_MESSAGE(read_bvh(text, "written", back, e), e.to_string());
+    const Motion back = read_bvh(text, "written");
     CHECK(keyanim::test::motion_difference(m, back) == "");
     CHECK(write_bvh(back) == text);
   }
@@ -507,9 +516,7 @@ TEST_CASE("writer is bit-exact for arbitrary finite doubles") {
   m.frame_time = 1.0 / 120.0;
   m.values = values;
   const std::string text = write_bvh(m);
-  Motion back;
-  BvhError e;
-  REQUIRE_MESSAGE(read_bvh(text, "written", back, e), e.to_string());
+  const Motion back = read_bvh(text, "written");
   CHECK(keyanim::test::motion_difference(m, back) == "");
 }
 

@@ -58,19 +58,14 @@ TEST_SUITE("corpus") {
     }
     for (const auto& path : files) {
       CAPTURE(path.filename().string());
-      Motion m;
-      BvhError err;
-      REQUIRE(read_bvh_file(path.string(), m, err));
-      EncodeSettings settings;  // 0.05% of the skeleton size, error mode
-      EncodeResult r;
-      std::string why;
-      REQUIRE(encode(m, settings, r, why));
+      const Motion m = read_bvh_file(path.string());
+      const EncodeSettings settings;  // 0.05% of the skeleton size, error mode
+      const EncodeResult r = encode(m, settings);
       const std::vector<uint8_t> bytes = write_kanim(r.clip);
       Clip clip;
       ErrorInfo info;
       REQUIRE(Clip::load(bytes, clip, &info) == Status::ok);
-      Motion back;
-      REQUIRE(decode_motion(clip, {}, back, why));
+      const Motion back = decode_motion(clip);
       CHECK(same_skeleton(m.skeleton, back.skeleton));
       CHECK(back.frame_count == m.frame_count);
       CHECK(back.frame_time == m.frame_time);

@@ -645,7 +645,7 @@ TEST_CASE("write then load equals to_clip bit-exactly") {
                                     random_clip(1, 500, 8), random_clip(2, 301, 31), random_clip(3, 2, 3)};
   for (const auto& e : clips) {
     CAPTURE(e.frame_count);
-    REQUIRE(keyanim::offline::validate_encoded_clip(e).empty());
+    REQUIRE_NOTHROW(keyanim::offline::validate_encoded_clip(e));
     const Clip ref = keyanim::offline::to_clip(e);
     for (int level : {0, 3, 19}) {
       const auto bytes = keyanim::offline::write_kanim(e, level);
@@ -670,8 +670,15 @@ TEST_CASE("key values are dequantized as float of q times step in double") {
   CHECK(k11.values[0] == float(123456 * 1e-3));
   CHECK(k11.values[1] == float(-654321 * 1e-3));
   CHECK(keyanim::test::channel_keys(l.clip, 2).values.empty());
-  CHECK(l.clip.sample_channel(2, 7.5f) == 0.0f);
-  CHECK(l.clip.sample_channel(3, 0.0f) == float(123 * 0.1));  // a constant before its key
+  float v = -1.0f;
+  CHECK(l.clip.sample_channel(2, 7.5f, v) == Status::ok);
+  CHECK(v == 0.0f);
+  CHECK(l.clip.sample_channel(3, 0.0f, v) == Status::ok);
+  CHECK(v == float(123 * 0.1));  // a constant before its key
+  // A channel the clip does not have, or a NaN position: refused, `v` unchanged.
+  CHECK(l.clip.sample_channel(l.clip.channel_count(), 0.0f, v) == Status::invalid_argument);
+  CHECK(l.clip.sample_channel(3, std::nanf(""), v) == Status::invalid_argument);
+  CHECK(v == float(123 * 0.1));
 }
 
 TEST_CASE("the cursor never changes a result") {
@@ -726,7 +733,9 @@ TEST_CASE("sample_time sample_channels and argument errors") {
   CHECK(same_bits(some[0], all[9]));
   CHECK(same_bits(some[1], all[0]));
   CHECK(same_bits(some[2], all[5]));
-  CHECK(same_bits(clip.sample_channel(5, 7.25f), all[5]));
+  float one = 0.0f;
+  REQUIRE(clip.sample_channel(5, 7.25f, one) == Status::ok);
+  CHECK(same_bits(one, all[5]));
   std::vector<float> t(clip.channel_count());
   REQUIRE(clip.sample_time(7.0 / 30.0, t) == Status::ok);  // frame 7 at 30 fps
   REQUIRE(clip.sample(7.0 / 30.0 / (1.0 / 30.0), all) == Status::ok);
@@ -769,8 +778,8 @@ TEST_CASE("the writer refuses clips that break the spec") {
   auto bad = [](auto mutate) {
     EncodedClip e = vector_rules();
     mutate(e);
-    CHECK(!keyanim::offline::validate_encoded_clip(e).empty());
-    CHECK(keyanim::offline::write_kanim(e).empty());
+    CHECK_THROWS_AS(keyanim::offline::validate_encoded_clip(e), keyanim::offline::Error);
+    CHECK_THROWS_AS(keyanim::offline::write_kanim(e), keyanim::offline::Error);
   };
   bad([](EncodedClip& e) { e.channels[0].frames = {0, 3, 3, 10, 19}; });
   bad([](EncodedClip& e) { e.channels[0].frames.back() = 20; });
@@ -1349,9 +1358,7 @@ TEST_CASE("decode_motion at the source rate at another fps with inbetweens and a
       if (m.value(row, c) != double(pose[c])) return false;
     return true;
   };
-  std::string error;
-  Motion m;
-  REQUIRE(decode_motion(clip, {}, m, error));
+  Motion m = decode_motion(clip);
   CHECK(m.frame_count == 240);
   CHECK(m.frame_time == 1.0 / 120.0);
   CHECK(m.values.size() == 240 * C);
@@ -1362,20 +1369,20 @@ TEST_CASE("decode_motion at the source rate at another fps with inbetweens and a
 
   ResampleOptions o;
   o.fps = 30;  // 239 / 120 s = 1.9917 s: frames at 0, 1/30 .. 59/30 (frame 236)
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 60);
   CHECK(m.frame_time == 1.0 / 30.0);
   CHECK(row_is(m, 1, 4));
   CHECK(row_is(m, 59, 236));
 
   o.fps = 50;  // every 2.4 source frames: 0, 2.4 .. 237.6 (99 x 2.4)
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 100);
   CHECK(row_is(m, 3, 3.0 / 50.0 / (1.0 / 120.0)));
 
   o = {};
   o.inbetweens = 3;
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 239 * 4 + 1);
   CHECK(m.frame_time == (1.0 / 120.0) / 4.0);
   CHECK(row_is(m, 8, 2));
@@ -1386,30 +1393,33 @@ TEST_CASE("decode_motion at the source rate at another fps with inbetweens and a
   o = {};
   o.first_frame = 5;
   o.last_frame = 20;
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 16);
   CHECK(row_is(m, 0, 5));
   CHECK(row_is(m, 15, 20));
   o.fps = 60;  // 15 source frames at 120 fps = 0.125 s: 8 frames, the range's end included
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 8);
   CHECK(row_is(m, 7, 19));
   o.fps = 40;  // every 3 source frames: 5, 8 .. 20, the end lands exactly
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 6);
   CHECK(row_is(m, 5, 20));
   o.fps = 0;
   o.inbetweens = 1;
-  REQUIRE(decode_motion(clip, o, m, error));
+  m = decode_motion(clip, o);
   CHECK(m.frame_count == 31);
   CHECK(row_is(m, 1, 5.5));
 
   // Nonsense options.
   auto fails = [&](ResampleOptions bad) {
-    Motion out;
-    std::string why;
-    CHECK(!decode_motion(clip, bad, out, why));
-    CHECK(!why.empty());
+    try {
+      decode_motion(clip, bad);
+      FAIL_CHECK("accepted");
+    } catch (const keyanim::offline::Error& e) {
+      CHECK(e.kind() == keyanim::offline::ErrorKind::invalid_argument);
+      CHECK(!e.message().empty());
+    }
   };
   o = {};
   o.fps = 30;
@@ -1435,7 +1445,7 @@ TEST_CASE("decode_motion at the source rate at another fps with inbetweens and a
   const Clip single = keyanim::offline::to_clip(vector_single());
   o = {};
   o.fps = 24;
-  REQUIRE(decode_motion(single, o, m, error));
+  m = decode_motion(single, o);
   CHECK(m.frame_count == 1);
   CHECK(m.value(0, 0) == double(float(95250 * 0.001)));
 }

@@ -235,9 +235,7 @@ TEST_CASE("shoulder Z rotation of a CMU clip: keys land on turning points") {
     KEYANIM_SKIP_CORPUS_TEST(path.string());
     return;
   }
-  keyanim::offline::Motion motion;
-  keyanim::offline::BvhError err;
-  REQUIRE_MESSAGE(keyanim::offline::read_bvh_file(path.string(), motion, err), err.to_string());
+  const keyanim::offline::Motion motion = keyanim::offline::read_bvh_file(path.string());
   // In CMU skeletons "RightShoulder" is the clavicle (unused in this clip: all zeros) and
   // "RightArm" the upper arm, whose rotation is the shoulder joint's.
   auto z_rotation = [&](const std::string& joint) -> std::vector<double> {
@@ -313,29 +311,25 @@ TEST_CASE("uniform_keys every N frames plus the last") {
 
 TEST_CASE("manual_keys sorts dedupes and adds the ends") {
   using keyanim::offline::manual_keys;
-  std::vector<uint32_t> out;
-  std::string error;
-  CHECK(manual_keys({30, 5, 30, 12, 5}, 100, out, error));
-  CHECK(out == std::vector<uint32_t>{0, 5, 12, 30, 99});
-  CHECK(manual_keys({}, 10, out, error));
-  CHECK(out == std::vector<uint32_t>{0, 9});
-  CHECK(manual_keys({0, 9}, 10, out, error));
-  CHECK(out == std::vector<uint32_t>{0, 9});
-  CHECK(manual_keys({0}, 1, out, error));
-  CHECK(out == std::vector<uint32_t>{0});
+  CHECK(manual_keys({30, 5, 30, 12, 5}, 100) == std::vector<uint32_t>{0, 5, 12, 30, 99});
+  CHECK(manual_keys({}, 10) == std::vector<uint32_t>{0, 9});
+  CHECK(manual_keys({0, 9}, 10) == std::vector<uint32_t>{0, 9});
+  CHECK(manual_keys({0}, 1) == std::vector<uint32_t>{0});
+  CHECK(manual_keys({}, 0).empty());
 }
 
 TEST_CASE("manual_keys rejects frames out of range and names them") {
   using keyanim::offline::manual_keys;
-  std::vector<uint32_t> out{1, 2, 3};
-  std::string error;
-  CHECK_FALSE(manual_keys({4, 100, 7}, 100, out, error));
-  CHECK(error.find("100") != std::string::npos);
-  CHECK(error.find("[0, 99]") != std::string::npos);
-  CHECK(out.empty());
-  error.clear();
-  CHECK_FALSE(manual_keys({0}, 0, out, error));
-  CHECK_FALSE(error.empty());
+  try {
+    manual_keys({4, 100, 7}, 100);
+    FAIL("accepted");
+  } catch (const keyanim::offline::Error& e) {
+    CHECK(e.kind() == keyanim::offline::ErrorKind::invalid_argument);
+    CHECK(e.message().find("100") != std::string::npos);
+    CHECK(e.message().find("[0, 99]") != std::string::npos);
+  }
+  CHECK_THROWS_WITH_AS(manual_keys({0}, 0), "key frame 0 given, but the motion has no frames",
+                       keyanim::offline::Error);
 }
 
 }  // TEST_SUITE

@@ -3,7 +3,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <utility>
 #include <random>
 
 #include "corpus_files.h"
@@ -51,14 +53,22 @@ Motion arm_motion(uint32_t frames) {
 
 // Encode, write, load, decode: the motion a user gets back.
 Motion round_trip(const Motion& m, const EncodeSettings& s, EncodeResult& r) {
-  std::string error;
-  REQUIRE(encode(m, s, r, error));
+  r = encode(m, s);
   const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level);
   Clip clip;
   REQUIRE(Clip::load(bytes, clip) == Status::ok);
-  Motion out;
-  REQUIRE(decode_motion(clip, {}, out, error));
-  return out;
+  return decode_motion(clip);
+}
+
+// The kind and message of the Error encode(m, s) throws (the test fails if it does not).
+std::pair<ErrorKind, std::string> encode_error(const Motion& m, const EncodeSettings& s) {
+  try {
+    encode(m, s);
+  } catch (const Error& e) {
+    return {e.kind(), e.message()};
+  }
+  FAIL("encode accepted it");
+  return {};
 }
 
 }  // namespace
@@ -147,9 +157,9 @@ TEST_SUITE("encode") {
     round_trip(m, s, r);
     CHECK(r.clip.channels[6].frames == std::vector<uint32_t>{0, 10, 30, 49});
     s.manual_frames = {50};
-    std::string error;
-    CHECK_FALSE(encode(m, s, r, error));
-    CHECK(error.find("50") != std::string::npos);
+    const auto [kind, message] = encode_error(m, s);
+    CHECK(kind == ErrorKind::invalid_argument);
+    CHECK(message.find("50") != std::string::npos);
   }
 
   TEST_CASE("curvature mode keys land in the channel and report their error") {
@@ -171,21 +181,25 @@ TEST_SUITE("encode") {
     CHECK(back.frame_count == 1);
     CHECK(measure_error(one, back).max_error <= r.tolerance_units);
     Motion none = arm_motion(0);
-    std::string error;
-    CHECK(encode(none, s, r, error));
+    CHECK(encode(none, s).total_keys == 0);
   }
 
   TEST_CASE("invalid settings are refused with a reason") {
     const Motion m = arm_motion(10);
     EncodeSettings s;
-    EncodeResult r;
-    std::string error;
     s.tolerance = -1;
-    CHECK_FALSE(encode(m, s, r, error));
-    CHECK(error.find("tolerance") != std::string::npos);
+    CHECK(encode_error(m, s).first == ErrorKind::invalid_argument);
+    CHECK(encode_error(m, s).second.find("tolerance") != std::string::npos);
+    CHECK_THROWS_AS(s.validate(), Error);
     s = {};
     s.tension = 2.0f;
-    CHECK_FALSE(encode(m, s, r, error));
+    CHECK(encode_error(m, s).first == ErrorKind::invalid_argument);
+    s = {};
+    Motion bad = m;
+    bad.values[3] = std::numeric_limits<double>::quiet_NaN();
+    CHECK(encode_error(bad, s).first == ErrorKind::malformed);
+    bad.values.pop_back();
+    CHECK(encode_error(bad, s).first == ErrorKind::invalid_argument);
   }
 
   TEST_CASE("the bytes do not depend on the number of threads") {
@@ -193,8 +207,7 @@ TEST_SUITE("encode") {
     Motion m = arm_motion(900);
     for (const auto& f : keyanim::test::corpus_bvh_files())
       if (f.filename() == "bvh11__131_01.bvh") {
-        BvhError err;
-        REQUIRE(read_bvh_file(f.string(), m, err));
+        m = read_bvh_file(f.string());
       }
     for (double tol : {0.05, 0.5}) {
       std::vector<uint8_t> first;
@@ -202,9 +215,7 @@ TEST_SUITE("encode") {
         EncodeSettings s;
         s.tolerance = tol;
         s.threads = threads;
-        EncodeResult r;
-        std::string error;
-        REQUIRE(encode(m, s, r, error));
+        EncodeResult r = encode(m, s);
         const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level, threads);
         CAPTURE(threads);
         CAPTURE(tol);
@@ -234,9 +245,7 @@ TEST_SUITE("encode") {
     for (double& v : m.values) v = angle(rng);
     EncodeSettings s;
     s.threads = 1;
-    EncodeResult r;
-    std::string error;
-    REQUIRE(encode(m, s, r, error));
+    EncodeResult r = encode(m, s);
     CHECK(r.error.max_error <= r.tolerance_units);
     CHECK(r.clip.channels.size() == size_t(kJoints) * 3);
   }

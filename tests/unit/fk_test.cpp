@@ -237,9 +237,7 @@ TEST_CASE("fk of two frames at once is bit for bit two frames one at a time") {
   if (paths.empty()) paths.push_back(KEYANIM_REPO_DATA_DIR "/cmu_131_03_hop.bvh");
   std::vector<Motion> motions;
   for (const std::string& path : paths) {
-    Motion m;
-    keyanim::offline::BvhError err;
-    REQUIRE(keyanim::offline::read_bvh_file(path, m, err));
+    Motion m = keyanim::offline::read_bvh_file(path);
     motions.push_back(std::move(m));
   }
   Motion odd;
@@ -373,16 +371,14 @@ TEST_CASE("fk world_positions_all matches per-frame world_positions") {
     keyanim::offline::world_positions(m.skeleton, m.frame(f), one);
     for (size_t j = 0; j < 3; ++j) CHECK(all[f * 3 + j] == one[j]);
   }
-  // Too few values for the last frame: it is NaN, not read past the end.
-  m.values.resize(2 * 9 + 4);
-  const auto partial = keyanim::offline::world_positions_all(m);
-  REQUIRE(partial.size() == 9);
-  CHECK(partial[3] == all[3]);
-  CHECK(std::isnan(partial[6][0]));
-  // first_channel past the row: every frame NaN.
+  // Too few values for the last frame: an error, not a read past the end.
+  Motion partial = m;
+  partial.values.resize(2 * 9 + 4);
+  CHECK_THROWS_AS(keyanim::offline::world_positions_all(partial), keyanim::offline::Error);
+  // first_channel past the row: an error.
   m.skeleton.joints[1].first_channel = 8;
   CHECK_FALSE(keyanim::offline::channel_columns_consistent(m.skeleton));
-  CHECK(std::isnan(keyanim::offline::world_positions_all(m)[0][0]));
+  CHECK_THROWS_AS(keyanim::offline::world_positions_all(m), keyanim::offline::Error);
 }
 
 TEST_CASE("fk skeleton size is the largest side of the rest-pose box") {
@@ -416,9 +412,7 @@ TEST_CASE("fk matches Blender and scipy positions for corpus files") {
       KEYANIM_SKIP_CORPUS_TEST(bvh.string());
       continue;
     }
-    Motion m;
-    keyanim::offline::BvhError err;
-    REQUIRE_MESSAGE(keyanim::offline::read_bvh_file(bvh.string(), m, err), err.to_string());
+    Motion m = keyanim::offline::read_bvh_file(bvh.string());
 
     const auto& nodes = ref.at("nodes");
     REQUIRE(nodes.size() == m.skeleton.joints.size());
@@ -468,12 +462,9 @@ TEST_CASE("fk of every corpus file is unchanged by a BVH write and read") {
   for (const auto& path : files) {
     const std::string file = path.string();
     CAPTURE(file);
-    Motion a;
-    Motion b;
-    keyanim::offline::BvhError err;
-    REQUIRE_MESSAGE(keyanim::offline::read_bvh_file(file, a, err), err.to_string());
+    const Motion a = keyanim::offline::read_bvh_file(file);
     const std::string text = keyanim::offline::write_bvh(a);
-    REQUIRE_MESSAGE(keyanim::offline::read_bvh(text, "rewritten", b, err), err.to_string());
+    const Motion b = keyanim::offline::read_bvh(text, "rewritten");
     const auto pa = keyanim::offline::world_positions_all(a);
     const auto pb = keyanim::offline::world_positions_all(b);
     REQUIRE(pa.size() == pb.size());
@@ -645,25 +636,32 @@ TEST_CASE("metrics modulo 360 channel comparison") {
   CHECK(r.channel_max[0] == 540.0);
 }
 
-TEST_CASE("metrics mismatched or broken motions report infinity") {
+TEST_CASE("metrics: mismatched or broken motions are errors; NaN values an infinite error") {
   const double inf = std::numeric_limits<double>::infinity();
   const Motion a = metrics_motion();
+  auto kind_of = [&](const Motion& b) {
+    try {
+      keyanim::offline::measure_error(a, b);
+    } catch (const keyanim::offline::Error& e) {
+      return e.kind();
+    }
+    FAIL("no error");
+    return keyanim::offline::ErrorKind::io;
+  };
   Motion fewer_frames = a;
   fewer_frames.frame_count = 2;
   fewer_frames.values.resize(2 * 13);
-  CHECK(keyanim::offline::measure_error(a, fewer_frames).max_error == inf);
+  CHECK(kind_of(fewer_frames) == keyanim::offline::ErrorKind::invalid_argument);
 
   Motion more_channels = a;
   more_channels.skeleton.joints[5].channels.push_back(kXr);
   more_channels.skeleton.assign_channel_columns();
   more_channels.values.assign(3 * 14, 0.0);
-  const auto r = keyanim::offline::measure_error(a, more_channels);
-  CHECK(r.max_error == inf);
-  CHECK(r.rms_error == inf);
+  CHECK(kind_of(more_channels) == keyanim::offline::ErrorKind::invalid_argument);
 
   Motion short_values = a;
   short_values.values.resize(20);
-  CHECK(keyanim::offline::measure_error(a, short_values).max_error == inf);
+  CHECK(kind_of(short_values) == keyanim::offline::ErrorKind::invalid_argument);
 
   Motion nan = a;
   set(nan, 1, 6, std::numeric_limits<double>::quiet_NaN());
@@ -671,6 +669,9 @@ TEST_CASE("metrics mismatched or broken motions report infinity") {
   CHECK(rn.max_error == inf);
   CHECK(rn.worst_frame == 1);
   CHECK(rn.channel_max[6] == inf);
+
+  for (double shell : {-1.0, std::numeric_limits<double>::quiet_NaN(), inf})
+    CHECK_THROWS_AS(keyanim::offline::measure_error(a, a, shell), keyanim::offline::Error);
 }
 
 }  // TEST_SUITE

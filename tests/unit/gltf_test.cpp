@@ -208,11 +208,8 @@ std::map<std::pair<int, std::string>, Track> tracks(const Glb& g) {
 }
 
 Glb export_glb(const Clip& clip, const GltfOptions& o, GltfReport* report = nullptr) {
-  GltfOutput out;
-  GltfReport r;
-  std::string error;
-  REQUIRE_MESSAGE(keyanim::offline::export_gltf(clip, o, out, r, error), error);
-  if (report) *report = r;
+  const GltfOutput out = keyanim::offline::export_gltf(clip, o);
+  if (report) *report = out.report;
   CHECK(out.bin.empty());
   return parse_glb(out.main);
 }
@@ -376,11 +373,8 @@ TEST_CASE("glTF asset: nodes, hierarchy, names, one animation, a packed buffer, 
   }
   CHECK(bytes == g.bin.size());
   // The same asset as .gltf + .bin.
-  GltfOutput split;
-  GltfReport r;
-  std::string error;
   o.bin_uri = "walk data.bin";
-  REQUIRE(keyanim::offline::export_gltf(clip, o, split, r, error));
+  const GltfOutput split = keyanim::offline::export_gltf(clip, o);
   CHECK(split.bin == g.bin);
   json doc = json::parse(split.main);
   CHECK(doc["buffers"][0]["uri"] == "walk data.bin");
@@ -458,13 +452,15 @@ TEST_CASE("glTF tolerance: the clip's own by default, else 0.05%, and refusals")
   export_glb(clip, pct, &r);
   CHECK(r.tolerance == doctest::Approx(0.005 * size).epsilon(1e-12));
 
-  GltfOutput out;
   std::string error;
   auto refused = [&](GltfOptions o) {
-    out.main = "stale";
-    const bool ok = keyanim::offline::export_gltf(clip, o, out, r, error);
-    CHECK(out.main.empty());
-    return !ok && !error.empty();
+    try {
+      keyanim::offline::export_gltf(clip, o);
+    } catch (const keyanim::offline::Error& refusal) {
+      error = refusal.message();
+      return !error.empty();
+    }
+    return false;
   };
   GltfOptions o;
   o.fps = -1;

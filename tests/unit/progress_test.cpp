@@ -16,12 +16,9 @@ using namespace keyanim::offline;
 namespace {
 
 Motion walk(std::vector<double>* parse_fractions = nullptr) {
-  Motion m;
-  BvhError err;
   BvhReadOptions options;
   if (parse_fractions) options.progress = [parse_fractions](double f) { parse_fractions->push_back(f); };
-  REQUIRE(read_bvh_file(KEYANIM_REPO_DATA_DIR "/cmu_131_03_hop.bvh", m, err, nullptr, options));
-  return m;
+  return read_bvh_file(KEYANIM_REPO_DATA_DIR "/cmu_131_03_hop.bvh", nullptr, options);
 }
 
 struct Call {
@@ -38,8 +35,7 @@ std::vector<Call> encode_recording(const Motion& m, EncodeSettings s, EncodeResu
     other_thread |= std::this_thread::get_id() != caller;
     calls.push_back({stage, f});
   };
-  std::string error;
-  REQUIRE(encode(m, s, r, error));
+  r = encode(m, s);
   CHECK_FALSE(other_thread);
   return calls;
 }
@@ -79,7 +75,7 @@ TEST_CASE("error mode: rounds of fitting and verifying, then measuring, on the c
     CAPTURE(threads);
     EncodeSettings s;
     s.threads = threads;
-    EncodeResult with, without;
+    EncodeResult with;
     const std::vector<EncodeStage> runs = runs_of(encode_recording(m, s, with));
     REQUIRE(runs.size() == 2 * with.iterations + 1);
     for (uint32_t r = 0; r < with.iterations; ++r) {
@@ -87,8 +83,7 @@ TEST_CASE("error mode: rounds of fitting and verifying, then measuring, on the c
       CHECK(runs[2 * r + 1] == EncodeStage::verifying);
     }
     CHECK(runs.back() == EncodeStage::measuring);
-    std::string error;
-    REQUIRE(encode(m, s, without, error));
+    const EncodeResult without = encode(m, s);
     CHECK(write_kanim(with.clip) == write_kanim(without.clip));  // the callback changes nothing
   }
 }
@@ -105,17 +100,14 @@ TEST_CASE("fixed key modes: fitting once, then measuring") {
 
 TEST_CASE("glTF export: rounds of fitting and verifying, then measuring, and the same asset") {
   const Motion m = walk();
-  EncodeResult r;
-  std::string error;
-  REQUIRE(encode(m, {}, r, error));
+  const EncodeResult r = encode(m, {});
   keyanim::Clip clip;
   REQUIRE(keyanim::Clip::load(write_kanim(r.clip), clip) == keyanim::Status::ok);
   GltfOptions options;
   std::vector<Call> calls;
   options.progress = [&](EncodeStage stage, double f) { calls.push_back({stage, f}); };
-  GltfOutput with, without;
-  GltfReport report;
-  REQUIRE(export_gltf(clip, options, with, report, error));
+  const GltfOutput with = export_gltf(clip, options);
+  const GltfReport& report = with.report;
   const std::vector<EncodeStage> runs = runs_of(calls);
   REQUIRE(runs.size() == 2 * report.rounds + 1);
   for (uint32_t i = 0; i < report.rounds; ++i) {
@@ -124,6 +116,6 @@ TEST_CASE("glTF export: rounds of fitting and verifying, then measuring, and the
   }
   CHECK(runs.back() == EncodeStage::measuring);
   options.progress = nullptr;
-  REQUIRE(export_gltf(clip, options, without, report, error));
+  const GltfOutput without = export_gltf(clip, options);
   CHECK(with.main == without.main);
 }

@@ -26,21 +26,32 @@ Motion two_nodes(uint32_t frames) {
 
 TEST_SUITE("signals") {
   TEST_CASE("check_motion accepts a plain motion and names what it refuses") {
+    // The kind and message check_motion throws, or "" for none.
+    auto refusal = [](const Motion& m, unsigned threads) -> std::string {
+      try {
+        check_motion(m, threads);
+      } catch (const Error& e) {
+        return std::string(error_kind_string(e.kind())) + ": " + e.message();
+      }
+      return "";
+    };
     Motion m = two_nodes(300);
-    for (unsigned threads : {1u, 2u}) CHECK(check_motion(m, threads).empty());
+    for (unsigned threads : {1u, 2u}) CHECK(refusal(m, threads).empty());
     m.values.pop_back();
-    CHECK(check_motion(m, 1).find("expected frames x channels") != std::string::npos);
+    CHECK(refusal(m, 1).find("invalid_argument: ") == 0);
+    CHECK(refusal(m, 1).find("expected frames x channels") != std::string::npos);
     m = two_nodes(300);
     m.values[7] = 2e37;
-    CHECK(check_motion(m, 1).find("binary32") != std::string::npos);
+    CHECK(refusal(m, 1).find("malformed: ") == 0);
+    CHECK(refusal(m, 1).find("binary32") != std::string::npos);
     m = two_nodes(300);
     m.values[7] = NAN;
-    CHECK(check_motion(m, 1).find("binary32") != std::string::npos);
+    CHECK(refusal(m, 1).find("binary32") != std::string::npos);
     // Values in range whose sum is not: a position beyond 1e37, found by FK at frame 299.
     m = two_nodes(300);
     m.skeleton.joints[1].offset = {9e36, 0, 0};
     m.values[299 * 2] = 9e36;
-    for (unsigned threads : {1u, 2u}) CHECK(check_motion(m, threads).find("overflow") != std::string::npos);
+    for (unsigned threads : {1u, 2u}) CHECK(refusal(m, threads).find("overflow") != std::string::npos);
   }
 
   TEST_CASE("channel layout and signals: a column, unwrapped when it is an angle") {

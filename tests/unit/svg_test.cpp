@@ -23,12 +23,7 @@ using namespace keyanim::offline;
 
 namespace {
 
-Motion walk() {
-  Motion m;
-  BvhError err;
-  REQUIRE_MESSAGE(read_bvh_file(KEYANIM_REPO_DATA_DIR "/cmu_02_01_walk.bvh", m, err), err.to_string());
-  return m;
-}
+Motion walk() { return read_bvh_file(KEYANIM_REPO_DATA_DIR "/cmu_02_01_walk.bvh"); }
 
 size_t count(const std::string& text, const std::string& what) {
   size_t n = 0;
@@ -194,8 +189,7 @@ TEST_CASE("plot marks exactly the encoder's keys on the reconstructed curve") {
       cli::ChannelPlot plot;
       REQUIRE(cli::plot_channel(m, s, c, "walk.bvh", plot, error));
       // The keys as the encoder chose them, from an encode of our own.
-      EncodeResult r;
-      REQUIRE(encode(m, s, r, error));
+      const EncodeResult r = encode(m, s);
       const std::vector<uint32_t>& frames = r.clip.channels[c].frames;
       REQUIRE(frames.size() > 2);
       CHECK(plot.key_count == frames.size());
@@ -223,8 +217,7 @@ TEST_CASE("plot of a frame range marks only the keys inside it") {
   const uint32_t c = *cli::find_channel(m.skeleton, "LeftUpLeg:Xrotation", error);
   cli::ChannelPlot plot;
   REQUIRE(cli::plot_channel(m, s, c, "walk.bvh", plot, error, {100, 200}));
-  EncodeResult r;
-  REQUIRE(encode(m, s, r, error));
+  const EncodeResult r = encode(m, s);
   std::vector<uint32_t> inside;
   for (const uint32_t f : r.clip.channels[c].frames)
     if (f >= 100 && f <= 200) inside.push_back(f);
@@ -248,11 +241,8 @@ TEST_CASE("render labels the node the error metrics name at their worst frame") 
   EncodeSettings s;
   s.key_mode = KeyMode::uniform;
   s.uniform_interval = 20;  // coarse on purpose: a visible, unambiguous worst node
-  EncodeResult r;
-  std::string error;
-  REQUIRE(encode(m, s, r, error));
-  Motion decoded;
-  REQUIRE(decode_motion(to_clip(r.clip), {}, decoded, error));
+  const EncodeResult r = encode(m, s);
+  const Motion decoded = decode_motion(to_clip(r.clip));
   const uint32_t frame = r.error.worst_frame;
   const cli::PoseFigure fig =
       cli::render_pose({{&m, "original"}, {&decoded, "reconstruction"}}, frame, "walk.bvh, frame");

@@ -132,6 +132,14 @@ void check_values(uint64_t frames, uint64_t channels, const std::string& what, c
 }
 
 Failure failure_of(const std::exception& e) {
+  if (const auto* o = dynamic_cast<const offline::Error*>(&e)) {
+    switch (o->kind()) {
+      case offline::ErrorKind::invalid_argument: return {kUsage, e.what()};
+      case offline::ErrorKind::unsupported: return {kUnsupported, e.what()};
+      case offline::ErrorKind::limit: return {kLimit, e.what()};
+      default: return {kBadInput, e.what()};
+    }
+  }
   if (dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e))
     return {kLimit, "out of memory"};
   if (const auto* s = dynamic_cast<const std::system_error*>(&e);
@@ -147,13 +155,11 @@ bool looks_like_kanim(const std::vector<uint8_t>& b) {
 offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g,
                                EncodeProgress* progress) {
   if (looks_like_kanim(bytes)) fail(kBadInput, path + ": is a .kanim file, expected BVH text");
-  offline::Motion m;
-  offline::BvhError err;
   std::vector<std::string> warnings;
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   offline::BvhReadOptions options;
   if (progress) options.progress = progress->parsing();
-  if (!offline::read_bvh(text, path, m, err, &warnings, options)) fail(kBadInput, err.to_string());
+  offline::Motion m = or_fail(kBadInput, "", [&] { return offline::read_bvh(text, path, &warnings, options); });
   if (progress && !warnings.empty()) progress->erase();
   if (g.verbosity > 0)
     for (const std::string& w : warnings) std::cerr << "keyanim: warning: " << printable(w) << "\n";
@@ -167,13 +173,11 @@ Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, cons
   limits.max_keys = std::min(limits.max_keys, g.limits.max_values);
   const Status s = Clip::load(bytes, clip, &info, limits);
   if (s != Status::ok) {
-    char where[64];
-    std::snprintf(where, sizeof where, "offset %llu (0x%llX)", static_cast<unsigned long long>(info.byte_offset),
-                  static_cast<unsigned long long>(info.byte_offset));
     const int code = s == Status::unsupported_version ? kUnsupported : s == Status::limit_exceeded ? kLimit : kBadInput;
-    fail(code, path + ": section " + (info.section.empty() ? "?" : info.section) + ", " + where + ": " +
-                   status_string(s) + ": " + info.detail +
-                   (s == Status::limit_exceeded ? " (keys are limited by --max-values; the loader's other limits are fixed)" : ""));
+    fail(code, offline::Error::kanim(path, info).what() +
+                   std::string(s == Status::limit_exceeded
+                                   ? " (keys are limited by --max-values; the loader's other limits are fixed)"
+                                   : ""));
   }
   return clip;
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/motion.h"
 
 namespace keyanim::cli {
@@ -38,9 +39,21 @@ struct Failure {
   std::string message;
 };
 [[noreturn]] void fail(int code, const std::string& message);
-// The exit code and message for an exception that is not a Failure: out of memory (or of
-// threads) is kLimit, anything else a bug (kInternal).
+// The exit code and message for an exception that is not a Failure: an offline::Error that no
+// command turned into one by its kind (invalid argument 1, malformed or unreadable input 2,
+// unsupported 3, a limit 6), out of memory (or of threads) kLimit, anything else a bug
+// (kInternal).
 Failure failure_of(const std::exception& e);
+// Runs `work`; an offline::Error it throws fails the command with `code`, `prefix` before the
+// error's text.
+template <class Work>
+auto or_fail(int code, const std::string& prefix, Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const offline::Error& e) {
+    fail(code, prefix + e.what());
+  }
+}
 
 // What keyanim takes from untrusted input at most (README, "Untrusted input").
 struct Limits {

@@ -62,8 +62,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
   if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())
     fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
   offline::FrameDecoder decoder;
-  std::string error;
-  if (!decoder.start(clip, opt, error)) fail(kUsage, error);
+  or_fail(kUsage, "", [&] { decoder.start(clip, opt); });
   check_values(decoder.frame_count(), clip.channel_count(), "decoding " + in, g);
 
   // Frame by frame from the clip to the output: memory does not grow with the frame count.
@@ -76,7 +75,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
     decoder.frame(i, row);
     writer.frame(row.data());
   }
-  if (!writer.finish()) fail(kInternal, "decode wrote a frame count other than the one it declared");
+  writer.finish();  // (an error here, a frame count other than declared, is a bug: exit 7)
   output.commit();
   bar.erase();
   if (g.verbosity > 0 && out != "-")

@@ -59,14 +59,12 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   }
   check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
-  offline::EncodeResult result;
-  std::string error;
   settings.progress = progress.encoding();
-  if (!offline::encode(motion, settings, result, error)) fail(kBadInput, in + ": " + error);
+  const offline::EncodeResult result = or_fail(kBadInput, in + ": ", [&] { return offline::encode(motion, settings); });
   std::vector<double>().swap(motion.values);
   progress.compressing();
+  // encode() made a clip the container can store: write_kanim cannot fail here.
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
-  if (bytes.empty()) fail(kBadInput, in + ": cannot be stored: " + offline::validate_encoded_clip(result.clip));
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   Encoded e;
   e.summary = encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);

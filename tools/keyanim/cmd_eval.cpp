@@ -98,16 +98,13 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
                          {"results", nlohmann::json::array()}};
   for (size_t r = 0; r < runs.size(); ++r) {
     const auto te = Clock::now();
-    offline::EncodeResult enc;
-    std::string error;
     const offline::EncodeSettings& settings = runs[r].settings;
-    if (!offline::encode(m, settings, enc, error)) fail(kBadInput, path + ": " + error);
+    const offline::EncodeResult enc = or_fail(kBadInput, path + ": ", [&] { return offline::encode(m, settings); });
     const std::vector<uint8_t> bytes = offline::write_kanim(enc.clip, settings.zstd_level);
     const double encode_ms = ms(te);
     const auto td = Clock::now();
     const Clip clip = load_kanim(path + " (encoded)", bytes, g);
-    offline::Motion back;
-    if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, path + ": " + error);
+    const offline::Motion back = or_fail(kBadInput, path + ": ", [&] { return offline::decode_motion(clip); });
     const double decode_ms = ms(td);
     const offline::ErrorReport e = offline::measure_error(m, back, enc.shell_units);
     const double n = double(bytes.size());

@@ -49,14 +49,12 @@ struct Poses {
   uint32_t frame_count() const { return clip ? clip->frame_count() : motion->frame_count; }
   // Frame `frame` (< frame_count()) alone, as a one-frame motion.
   offline::Motion one_frame(uint32_t frame) const {
-    offline::Motion m;
     if (clip) {
       offline::ResampleOptions o;
       o.first_frame = o.last_frame = frame;
-      std::string error;
-      if (!offline::decode_motion(*clip, o, m, error)) fail(kBadInput, error);
-      return m;
+      return or_fail(kBadInput, "", [&] { return offline::decode_motion(*clip, o); });
     }
+    offline::Motion m;
     m.skeleton = motion->skeleton;
     m.frame_count = 1;
     m.frame_time = motion->frame_time;
@@ -109,13 +107,12 @@ int cmd_render(const Argv& argv, Globals& g) {
     title += " against " + name_of(*against);
   } else if (poses.motion) {
     check_settings_for(settings, *poses.motion, in);
-    offline::EncodeResult result;
-    std::string error;
-    if (!offline::encode(*poses.motion, settings, result, error)) fail(kBadInput, in + ": " + error);
+    const offline::EncodeResult result =
+        or_fail(kBadInput, in + ": ", [&] { return offline::encode(*poses.motion, settings); });
     const Clip clip = offline::to_clip(result.clip);
     offline::ResampleOptions o;
     o.first_frame = o.last_frame = frame;
-    if (!offline::decode_motion(clip, o, second, error)) fail(kBadInput, in + ": " + error);
+    second = or_fail(kBadInput, in + ": ", [&] { return offline::decode_motion(clip, o); });
     series.front().label = "original";
     series.push_back({&second, "reconstruction (" + std::to_string(result.total_keys) + " keys, " +
                                    settings_text(settings, result.tolerance_units) + ")"});

@@ -67,9 +67,8 @@ int cmd_verify(const Argv& argv, Globals& g) {
       ok = false;
       why = "the clip's skeleton or frame count differs from " + *orig_path;
     } else {
-      offline::Motion back;
-      std::string error;
-      if (!offline::decode_motion(clip, {}, back, error)) fail(kBadInput, in + ": " + error);
+      const offline::Motion back = or_fail(kBadInput, in + ": ", [&] { return offline::decode_motion(clip); });
+      // The same layout: checked above.
       const offline::ErrorReport e = offline::measure_error(orig, back, shell_units(shell, clip, orig));
       j["error"] = error_json(orig.skeleton, e);
       if (limit) {

@@ -83,7 +83,7 @@ std::vector<EvalRun> eval_runs(const Args& args) {
       EvalRun run{tol, keys, common};
       parse_key_mode(keys, run.settings);
       parse_tolerance(tol, run.settings);
-      if (const std::string why = run.settings.validate(); !why.empty()) fail(kUsage, why);
+      or_fail(kUsage, "", [&] { run.settings.validate(); });
       runs.push_back(std::move(run));
     }
   }

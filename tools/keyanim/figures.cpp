@@ -96,9 +96,19 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
     return false;
   }
   offline::EncodeResult result;
-  if (!offline::encode(motion, settings, result, error)) return false;
+  try {
+    result = offline::encode(motion, settings);
+  } catch (const offline::Error& e) {
+    error = e.what();
+    return false;
+  }
   // The decoder's own arrays: what a game would sample.
   const Clip clip = offline::to_clip(result.clip);
+  auto value_at = [&](double x) {  // the channel exists and x is finite: sample_channel succeeds
+    float v = 0.0f;
+    (void)clip.sample_channel(channel, static_cast<float>(x), v);
+    return double(v);
+  };
 
   const uint32_t joint = sk.joint_of_channel(channel);
   const ChannelType type = sk.joints[joint].channels[channel - sk.joints[joint].first_channel];
@@ -113,7 +123,7 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   double shift = 0.0;
   if (rotation) {
     offline::unwrap_degrees(original);
-    shift = 360.0 * std::round((original[0] - clip.sample_channel(channel, 0.0f)) / 360.0);
+    shift = 360.0 * std::round((original[0] - value_at(0.0)) / 360.0);
   }
 
   // Plot area and the reconstruction's sampling: between frames too when a frame is wide
@@ -124,7 +134,7 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   std::vector<double> recon_pos, recon;
   for (uint32_t f = first; f <= last; ++f)
     for (uint32_t j = 0; j < (f < last ? steps : 1u); ++j) recon_pos.push_back(f + double(j) / steps);
-  for (const double x : recon_pos) recon.push_back(clip.sample_channel(channel, static_cast<float>(x)) + shift);
+  for (const double x : recon_pos) recon.push_back(value_at(x) + shift);
 
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (uint32_t f = first; f <= last; ++f) lo = std::min(lo, original[f]), hi = std::max(hi, original[f]);

@@ -73,14 +73,12 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
 
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
   check_values(clip.frame_count(), clip.channel_count(), "exporting " + in, g);
-  offline::GltfOutput asset;
-  offline::GltfReport r;
-  std::string error;
   Progress bar(g, in);
   EncodeProgress progress(&bar, o.fps == 0.0, false);
   o.progress = progress.encoding();
-  if (!offline::export_gltf(clip, o, asset, r, error)) fail(kUsage, in + ": glTF export: " + error);
+  const offline::GltfOutput asset = or_fail(kUsage, in + ": glTF export: ", [&] { return offline::export_gltf(clip, o); });
   bar.erase();
+  const offline::GltfReport& r = asset.report;
   if (bin && !asset.bin.empty()) {  // a clip without frames has no buffer: no .bin is left
     bin->write(asset.bin);
     bin->commit();

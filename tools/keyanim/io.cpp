@@ -120,10 +120,8 @@ Start check_start(const std::string& path, const std::vector<uint8_t>& b, Kind k
   }
   const Start s = bvh_start(b);
   if (s != Start::no) return s;
-  offline::Motion m;
-  offline::BvhError err;
   const std::string_view text(reinterpret_cast<const char*>(b.data()), b.size());
-  if (!offline::read_bvh(text, path, m, err)) fail(kBadInput, err.to_string());
+  or_fail(kBadInput, "", [&] { return offline::read_bvh(text, path); });
   fail(kBadInput, path + ": not BVH text");  // not reached: the reader wants HIERARCHY first
 }
 

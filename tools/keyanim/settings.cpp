@@ -56,10 +56,8 @@ void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {
 }
 
 void check_settings_for(const offline::EncodeSettings& s, const offline::Motion& motion, const std::string& path) {
-  std::vector<uint32_t> keys;
-  std::string error;
-  if (s.key_mode == offline::KeyMode::manual && !offline::manual_keys(s.manual_frames, motion.frame_count, keys, error))
-    fail(kUsage, path + ": --keys manual: " + error);
+  if (s.key_mode == offline::KeyMode::manual)
+    or_fail(kUsage, path + ": --keys manual: ", [&] { return offline::manual_keys(s.manual_frames, motion.frame_count); });
 }
 
 offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool read_keys) {
@@ -75,7 +73,7 @@ offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool 
     }
   }
   if (auto l = args.get("--level")) s.zstd_level = static_cast<int>(parse_uint("--level", *l));
-  if (const std::string why = s.validate(); !why.empty()) fail(kUsage, why);
+  or_fail(kUsage, "", [&] { s.validate(); });
   return s;
 }
 

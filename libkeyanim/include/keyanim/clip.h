@@ -94,8 +94,9 @@ class Clip {
   // >= channel_count() is invalid_argument.
   Status sample_channels(double frame_position, std::span<const uint32_t> channels,
                          std::span<float> out) const noexcept;
-  // One channel (< channel_count(), else 0), no other checks.
-  float sample_channel(uint32_t c, float frame_position) const noexcept;
+  // One channel at frame position f into `out`: invalid_argument (and `out` unchanged) for
+  // c >= channel_count() or a NaN position.
+  Status sample_channel(uint32_t c, float frame_position, float& out) const noexcept;
 
   // Engine-ready poses (pose.h). Local: one Transform per node of skeleton() (joints and End
   // Sites, in node order): the rotation of the node's Euler channels in their order, and its

@@ -18,11 +18,14 @@
 
 namespace keyanim::offline {
 
-std::string BvhError::to_string() const {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
-}
-
 namespace {
+
+// Where and why parsing stopped; read_bvh throws it as an Error.
+struct BvhError {
+  uint32_t line = 0, column = 0;
+  std::string message;
+  ErrorKind kind = ErrorKind::malformed;
+};
 
 // Character classes. Blank: separates tokens within a line. Eol: ends a line (\n, \r, \r\n).
 constexpr uint8_t kOther = 0;
@@ -193,11 +196,8 @@ class Parser {
   // An empty token was taken at the cursor, which still points at the line or file end.
   std::string describe(const Token& t) const { return t.text.empty() ? describe_cursor() : quote(t.text); }
 
-  bool fail(uint32_t line, uint32_t column, std::string message) {
-    err_.file = file_;
-    err_.line = line;
-    err_.column = column;
-    err_.message = std::move(message);
+  bool fail(uint32_t line, uint32_t column, std::string message, ErrorKind kind = ErrorKind::malformed) {
+    err_ = {line, column, std::move(message), kind};
     return false;
   }
   bool fail(const Token& t, std::string message) { return fail(t.line, t.column, std::move(message)); }
@@ -287,8 +287,9 @@ bool Parser::parse_channels(Joint& j) {
 // that way (the writer could not write it back unambiguously).
 bool Parser::begin_node(Skeleton& s, int32_t parent, bool end_site, const Token& keyword) {
   if (s.joints.size() >= options_.max_joints)
-    return fail(keyword, "expected at most " + std::to_string(options_.max_joints) +
-                             " nodes (max_joints), found more");
+    return fail(keyword.line, keyword.column,
+                "expected at most " + std::to_string(options_.max_joints) + " nodes (max_joints), found more",
+                ErrorKind::limit);
   skip_blanks();
   const char* name_begin = p_;
   while (p_ != end_ && !is_eol(*p_)) ++p_;
@@ -413,8 +414,10 @@ bool Parser::parse_motion_header(uint64_t& declared, Token& declared_tok, double
   skip_blanks();
   if (!parse_count(UINT64_MAX, "a frame count", declared, declared_tok)) return false;
   if (declared > options_.max_frames)
-    return fail(declared_tok, "expected at most " + std::to_string(options_.max_frames) +
-                                  " frames (max_frames), found " + std::to_string(declared));
+    return fail(declared_tok.line, declared_tok.column,
+                "expected at most " + std::to_string(options_.max_frames) + " frames (max_frames), found " +
+                    std::to_string(declared),
+                ErrorKind::limit);
 
   skip_space();
   t = here();
@@ -471,8 +474,9 @@ bool Parser::parse_frames(Motion& m, uint64_t declared, const Token& declared_to
       return fail(line_, column_of(p_), "expected an empty line (the skeleton has no channels), found " +
                                             quote(word_at(p_)));
     if (lines >= options_.max_frames)
-      return fail(line_, column_of(p_), "expected at most " + std::to_string(options_.max_frames) +
-                                            " motion lines (max_frames), found more");
+      return fail(line_, column_of(p_),
+                  "expected at most " + std::to_string(options_.max_frames) + " motion lines (max_frames), found more",
+                  ErrorKind::limit);
     if (values.size() - n < channels) values.resize(std::max(n + channels, values.size() + values.size() / 2));
     double* out = values.data() + n;
     const char* p = p_;
@@ -541,41 +545,29 @@ bool Parser::parse(Motion& m) {
 
 }  // namespace
 
-bool read_bvh(std::string_view text, const std::string& file_name, Motion& out, BvhError& err,
-              std::vector<std::string>* warnings, const BvhReadOptions& options) {
+Motion read_bvh(std::string_view text, const std::string& file_name, std::vector<std::string>* warnings,
+                const BvhReadOptions& options) {
   Motion m;
+  BvhError err;
   std::vector<std::string> local_warnings;
   Parser parser(text, file_name, options, err, warnings ? &local_warnings : nullptr);
-  if (!parser.parse(m)) {
-    out = Motion{};
-    return false;
-  }
-  out = std::move(m);
+  if (!parser.parse(m)) throw Error::bvh(file_name, err.line, err.column, std::move(err.message), err.kind);
   if (warnings) warnings->insert(warnings->end(), local_warnings.begin(), local_warnings.end());
-  return true;
+  return m;
 }
 
-bool read_bvh_file(const std::string& path, Motion& out, BvhError& err, std::vector<std::string>* warnings,
-                   const BvhReadOptions& options) {
-  auto io_error = [&](const char* what, int code) {
-    out = Motion{};
-    err.file = path;
-    err.line = 0;
-    err.column = 0;
-    err.message = std::string(what) + ": " + std::generic_category().message(code);
-    return false;
-  };
+Motion read_bvh_file(const std::string& path, std::vector<std::string>* warnings, const BvhReadOptions& options) {
   // The size is only a hint for one allocation; pipes and the like just grow.
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::is_directory(status)) return io_error("cannot read file", EISDIR);
+  if (!ec && std::filesystem::is_directory(status)) throw Error::io(path, "cannot read file", EISDIR);
   size_t hint = size_t(1) << 16;
   if (!ec && std::filesystem::is_regular_file(status)) {
     const auto size = std::filesystem::file_size(path, ec);
     if (!ec) hint = size_t(size) + 1;  // +1: the last read sees EOF without growing
   }
   std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return io_error("cannot open file", errno);
+  if (!f) throw Error::io(path, "cannot open file", errno);
   std::string text;
   size_t used = 0;
   text.resize(hint);
@@ -589,8 +581,8 @@ bool read_bvh_file(const std::string& path, Motion& out, BvhError& err, std::vec
   const bool bad = std::ferror(f) != 0;
   const int code = errno;
   std::fclose(f);
-  if (bad) return io_error("cannot read file", code ? code : EIO);
-  return read_bvh(text, path, out, err, warnings, options);
+  if (bad) throw Error::io(path, "cannot read file", code ? code : EIO);
+  return read_bvh(text, path, warnings, options);
 }
 
 }  // namespace keyanim::offline

@@ -271,9 +271,11 @@ void BvhWriter::flush() {
   used_ = 0;
 }
 
-bool BvhWriter::finish() {
+void BvhWriter::finish() {
   flush();
-  return written_ == declared_;
+  if (written_ != declared_)
+    throw Error(ErrorKind::invalid_argument, "BVH writer: " + std::to_string(written_) + " frames given, " +
+                                                 std::to_string(declared_) + " declared");
 }
 
 std::string write_bvh(const Motion& motion) {

@@ -217,9 +217,8 @@ uint32_t crc32_of(const uint8_t* p, size_t n) {
   return static_cast<uint32_t>(crc);
 }
 
-}  // namespace
-
-std::string validate_encoded_clip(const EncodedClip& clip) {
+// The first rule of spec/FORMAT.md that `clip` breaks, or "".
+std::string first_broken_rule(const EncodedClip& clip) {
   const auto& joints = clip.skeleton.joints;
   if (joints.size() > UINT32_MAX) return "too many nodes";
   uint64_t channel_sum = 0;
@@ -256,8 +255,14 @@ std::string validate_encoded_clip(const EncodedClip& clip) {
   return {};
 }
 
+}  // namespace
+
+void validate_encoded_clip(const EncodedClip& clip) {
+  if (std::string rule = first_broken_rule(clip); !rule.empty()) throw Error(ErrorKind::invalid_argument, rule);
+}
+
 std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level, unsigned threads) {
-  if (!validate_encoded_clip(clip).empty()) return {};
+  validate_encoded_clip(clip);
   uint64_t keys = 0;
   for (const auto& c : clip.channels) keys += c.frames.size();
 

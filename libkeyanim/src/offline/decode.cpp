@@ -19,43 +19,31 @@
 
 namespace keyanim::offline {
 
-bool FrameDecoder::start(const Clip& clip, const ResampleOptions& options, std::string& error) {
-  error.clear();
+void FrameDecoder::start(const Clip& clip, const ResampleOptions& options) {
+  auto invalid = [](const std::string& why) { throw Error(ErrorKind::invalid_argument, why); };
   clip_ = &clip;
   options_ = options;
   count_ = 0;
   const uint32_t frames = clip.frame_count();
-  if (std::isnan(options.fps) || options.fps < 0.0 || std::isinf(options.fps)) {
-    error = "fps must be a finite number > 0 (or 0 for the source rate)";
-    return false;
-  }
-  if (options.fps > 0.0 && options.inbetweens > 0) {
-    error = "give either fps or inbetweens, not both";
-    return false;
-  }
-  if (options.fps > 0.0 && !(clip.frame_time() > 0.0) && frames > 1) {
-    error = "the clip has no frame time; cannot resample to fps";
-    return false;
-  }
+  if (std::isnan(options.fps) || options.fps < 0.0 || std::isinf(options.fps))
+    invalid("fps must be a finite number > 0 (or 0 for the source rate)");
+  if (options.fps > 0.0 && options.inbetweens > 0)
+    invalid("give either fps or inbetweens, not both");
+  if (options.fps > 0.0 && !(clip.frame_time() > 0.0) && frames > 1)
+    invalid("the clip has no frame time; cannot resample to fps");
   const double per = static_cast<double>(options.inbetweens) + 1.0;
   frame_time_ = options.fps > 0.0 ? 1.0 / options.fps : clip.frame_time() / per;
   if (frames == 0) {
-    if (options.first_frame != 0 || options.last_frame != UINT32_MAX) {
-      error = "the clip has no frames; no frame range can be decoded";
-      return false;
-    }
-    return true;
+    if (options.first_frame != 0 || options.last_frame != UINT32_MAX)
+      invalid("the clip has no frames; no frame range can be decoded");
+    return;
   }
   first_ = options.first_frame;
   last_ = options.last_frame == UINT32_MAX ? frames - 1 : options.last_frame;
-  if (last_ >= frames) {
-    error = "last_frame " + std::to_string(last_) + " is beyond the clip's last frame " + std::to_string(frames - 1);
-    return false;
-  }
-  if (first_ > last_) {
-    error = "first_frame " + std::to_string(first_) + " is after last_frame " + std::to_string(last_);
-    return false;
-  }
+  if (last_ >= frames)
+    invalid("last_frame " + std::to_string(last_) + " is beyond the clip's last frame " + std::to_string(frames - 1));
+  if (first_ > last_)
+    invalid("first_frame " + std::to_string(first_) + " is after last_frame " + std::to_string(last_));
   const uint64_t span = last_ - first_;
   if (options.fps > 0.0) {
     // Saturates rather than overflows: the caller compares the count with its own limits.
@@ -66,7 +54,6 @@ bool FrameDecoder::start(const Clip& clip, const ResampleOptions& options, std::
   }
   pose_.assign(clip.channel_count(), 0.0f);
   if (cursor_.prepare(clip) != Status::ok) throw std::bad_alloc();
-  return true;
 }
 
 void FrameDecoder::frame(uint64_t i, std::span<double> row) {
@@ -85,15 +72,13 @@ void FrameDecoder::frame(uint64_t i, std::span<double> row) {
   for (size_t c = 0; c < pose_.size() && c < row.size(); ++c) row[c] = static_cast<double>(pose_[c]);
 }
 
-bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error) {
+Motion decode_motion(const Clip& clip, const ResampleOptions& options) {
   FrameDecoder decoder;
-  if (!decoder.start(clip, options, error)) return false;
+  decoder.start(clip, options);
   const uint64_t count = decoder.frame_count();
   const uint32_t channels = clip.channel_count();
-  if (count > UINT32_MAX || (channels > 0 && count > (uint64_t(1) << 40) / channels)) {
-    error = "too many output frames (" + std::to_string(count) + ")";
-    return false;
-  }
+  if (count > UINT32_MAX || (channels > 0 && count > (uint64_t(1) << 40) / channels))
+    throw Error(ErrorKind::limit, "too many output frames (" + std::to_string(count) + ")");
   Motion m;
   m.skeleton = clip.skeleton();
   m.skeleton.assign_channel_columns();
@@ -101,8 +86,7 @@ bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out
   m.frame_time = decoder.frame_time();
   m.values.resize(static_cast<size_t>(count) * channels);
   for (uint64_t i = 0; i < count; ++i) decoder.frame(i, {m.values.data() + i * channels, channels});
-  out = std::move(m);
-  return true;
+  return m;
 }
 
 }  // namespace keyanim::offline

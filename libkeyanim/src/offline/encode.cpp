@@ -162,8 +162,8 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
 }
 
 // Fits every channel; in error mode, rounds of verification and tightening until every node is
-// within the tolerance. Returns the number of rounds, or 0 with `error` set.
-uint32_t fit_within_tolerance(const Job& job, std::string& error) {
+// within the tolerance. Returns the number of rounds; throws Error (limit) if that never comes.
+uint32_t fit_within_tolerance(const Job& job) {
   const Motion& m = job.m;
   Budgets budgets(m.skeleton, base_tolerances(m, job.tol_units, job.shell), m.frame_count);
   std::vector<ChannelFitter> fitters(m.channel_count(), ChannelFitter(fit_options(job.settings)));
@@ -173,44 +173,40 @@ uint32_t fit_within_tolerance(const Job& job, std::string& error) {
     fit_channels(job, round, budgets, fitters, marks);
     if (job.settings.key_mode != KeyMode::error || m.frame_count == 0) return round + 1;
     if (!verify_and_tighten(job, round, budgets, marks)) return round + 1;
-    if (round + 1 >= kMaxRounds) {
-      error = "could not reach the tolerance of " + std::to_string(job.tol_units) + " units after " +
-              std::to_string(kMaxRounds) + " rounds (below float32 precision?)";
-      return 0;
-    }
+    if (round + 1 >= kMaxRounds)
+      throw Error(ErrorKind::limit, "could not reach the tolerance of " + std::to_string(job.tol_units) +
+                                        " units after " + std::to_string(kMaxRounds) +
+                                        " rounds (below float32 precision?)");
   }
 }
 
 }  // namespace
 
-std::string EncodeSettings::validate() const {
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return "tolerance must be a positive number";
-  if (tolerance_in_percent && tolerance > 100.0) return "tolerance in percent must be at most 100";
-  if (!(shell >= 0.0) || !std::isfinite(shell)) return "shell distance must be a number >= 0";
-  if (shell_in_percent && shell > 100.0) return "shell distance in percent must be at most 100";
-  if (uniform_interval < 1) return "uniform interval must be at least 1";
-  if (!(tension >= -1.0f && tension <= 1.0f)) return "tension must be in [-1, 1]";
-  if (zstd_level < 1 || zstd_level > 22) return "zstd level must be in 1..22";
-  if (key_mode == KeyMode::manual && manual_frames.empty()) return "manual key mode needs a list of frames";
-  return {};
+void EncodeSettings::validate() const {
+  auto invalid = [](const char* why) { throw Error(ErrorKind::invalid_argument, why); };
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) invalid("tolerance must be a positive number");
+  if (tolerance_in_percent && tolerance > 100.0) invalid("tolerance in percent must be at most 100");
+  if (!(shell >= 0.0) || !std::isfinite(shell)) invalid("shell distance must be a number >= 0");
+  if (shell_in_percent && shell > 100.0) invalid("shell distance in percent must be at most 100");
+  if (uniform_interval < 1) invalid("uniform interval must be at least 1");
+  if (!(tension >= -1.0f && tension <= 1.0f)) invalid("tension must be in [-1, 1]");
+  if (zstd_level < 1 || zstd_level > 22) invalid("zstd level must be in 1..22");
+  if (key_mode == KeyMode::manual && manual_frames.empty()) invalid("manual key mode needs a list of frames");
 }
 
-bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, std::string& error) {
-  error = settings.validate();
-  if (!error.empty()) return false;
+EncodeResult encode(const Motion& m, const EncodeSettings& settings) {
+  settings.validate();
   const unsigned threads = resolve_threads(settings.threads);
-  error = check_motion(m, threads);
-  if (!error.empty()) return false;
+  check_motion(m, threads);
   // Tolerance in file units. A skeleton with no extent (a lone root) falls back to its path.
   const double size = reference_size(m);
   const double tol_units = settings.tolerance_in_percent ? settings.tolerance / 100.0 * size : settings.tolerance;
+  if (!(tol_units > 0.0))
+    throw Error(ErrorKind::invalid_argument,
+                "the skeleton has no extent, so a tolerance in percent means nothing: give it in file units");
   const double shell = settings.shell_in_percent ? settings.shell / 100.0 * size : settings.shell;
-  if (!(tol_units > 0.0)) {
-    error = "the skeleton has no extent, so a tolerance in percent means nothing: give it in file units";
-    return false;
-  }
+  EncodeResult out;
   EncodedClip& enc = out.clip;
-  enc = EncodedClip{};
   enc.skeleton = m.skeleton;
   enc.frame_count = m.frame_count;
   enc.frame_time = m.frame_time;
@@ -218,17 +214,16 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   enc.channels.resize(m.channel_count());
   Job job{m, settings, tol_units, shell, threads, {}, channel_layout(m.skeleton), enc};
   if (settings.key_mode == KeyMode::uniform) job.fixed_keys = uniform_keys(m.frame_count, settings.uniform_interval);
-  if (settings.key_mode == KeyMode::manual && !manual_keys(settings.manual_frames, m.frame_count, job.fixed_keys, error))
-    return false;
-  const uint32_t rounds = fit_within_tolerance(job, error);
-  if (rounds == 0) return false;
+  if (settings.key_mode == KeyMode::manual) job.fixed_keys = manual_keys(settings.manual_frames, m.frame_count);
+  const uint32_t rounds = fit_within_tolerance(job);
   release_free_memory();  // the rounds' budgets and fits, before the measurement takes its own
 
   // A clip the container cannot store (a frame time of 0 with several frames, a value whose
   // quantized integer overflows in the fixed-key modes) is an error, not a result.
-  if (std::string why = validate_encoded_clip(enc); !why.empty()) {
-    error = "cannot be stored: " + why;
-    return false;
+  try {
+    validate_encoded_clip(enc);
+  } catch (const Error& e) {
+    throw Error(ErrorKind::malformed, "cannot be stored: " + e.message());
   }
   report(settings, EncodeStage::measuring, 0, 1);
   out.error = measure_encoded(m, enc, shell, threads);
@@ -240,7 +235,7 @@ bool encode(const Motion& m, const EncodeSettings& settings, EncodeResult& out, 
   for (const EncodedChannel& ch : enc.channels) out.total_keys += ch.frames.size();
   enc.notes = encoder_notes(settings, tol_units, m.skeleton, out.error, out.iterations);
   release_free_memory();  // the measurement's clip, before the caller writes the file
-  return true;
+  return out;
 }
 
 }  // namespace keyanim::offline

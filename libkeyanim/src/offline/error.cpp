@@ -23,9 +23,9 @@ Error::Error(ErrorKind kind, std::string message, std::string file)
   compose();
 }
 
-Error Error::bvh(std::string file, uint32_t line, uint32_t column, std::string message) {
+Error Error::bvh(std::string file, uint32_t line, uint32_t column, std::string message, ErrorKind kind) {
   Error e;
-  e.kind_ = ErrorKind::malformed;
+  e.kind_ = kind;
   e.file_ = std::move(file);
   e.line_ = line;
   e.column_ = line > 0 ? column : 0;

@@ -12,6 +12,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "keyanim/offline/error.h"
+
 namespace keyanim::offline {
 namespace {
 
@@ -363,14 +365,13 @@ std::vector<Vec3> world_positions_all(const Motion& motion, PositionReading read
   const size_t n = motion.skeleton.joints.size();
   const size_t channels = motion.channel_count();
   const size_t frames = motion.frame_count;
-  // A malformed Motion (too few values) must not be read past its end.
-  const size_t complete = !channel_columns_consistent(motion.skeleton) ? 0
-                          : channels == 0 ? frames
-                                          : std::min(frames, motion.values.size() / channels);
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  std::vector<Vec3> out(frames * n, Vec3{kNaN, kNaN, kNaN});
+  // A malformed Motion must not be read past its end.
+  if (!channel_columns_consistent(motion.skeleton) || motion.values.size() < frames * channels)
+    throw Error(ErrorKind::invalid_argument, "the motion's values do not fill frames x channels, or its channel "
+                                             "columns lie outside a frame");
+  std::vector<Vec3> out(frames * n);
   std::vector<Mat3> rotations(n);
-  for (size_t f = 0; f < complete; ++f) {
+  for (size_t f = 0; f < frames; ++f) {
     pose_frame(motion.skeleton, OneRow{motion.values.data() + f * channels}, out.data() + f * n, rotations.data(),
                nullptr, reading);
   }

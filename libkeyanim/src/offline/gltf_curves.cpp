@@ -20,7 +20,9 @@ ChannelCurve::ChannelCurve(const Clip& clip, uint32_t channel) : clip_(&clip), c
 }
 
 float ChannelCurve::value(double frame_position) const noexcept {
-  return clip_->sample_channel(channel_, static_cast<float>(frame_position));
+  float v = 0.0f;
+  (void)clip_->sample_channel(channel_, static_cast<float>(frame_position), v);  // the channel exists; positions are finite
+  return v;
 }
 
 double ChannelCurve::slope(uint32_t f, bool from_left) const noexcept {

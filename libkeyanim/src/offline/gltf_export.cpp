@@ -25,39 +25,37 @@ constexpr double kMaxWorkingBytes = double(1u << 30);
 constexpr double kMaxResampledKeys = double(1u << 24);
 constexpr double kRoundingMargin = 1e-6;  // of the skeleton size
 
-bool check_options(const Clip& clip, const GltfOptions& o, Window& w, std::string& error) {
-  if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) error = "fps must be positive and finite";
-  else if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
-    error = "tolerance must be positive and finite (at most 100 in percent)";
-  else if (!std::isfinite(o.shell_percent)) error = "shell distance must be finite";
-  if (!error.empty()) return false;
+[[noreturn]] void invalid(const std::string& why) { throw Error(ErrorKind::invalid_argument, why); }
+
+// The frame window of the options; throws Error (invalid_argument) for options that make no sense.
+Window check_options(const Clip& clip, const GltfOptions& o) {
+  if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) invalid("fps must be positive and finite");
+  if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
+    invalid("tolerance must be positive and finite (at most 100 in percent)");
+  if (!std::isfinite(o.shell_percent)) invalid("shell distance must be finite");
+  Window w;
   const uint32_t frames = clip.frame_count();
-  const bool ranged = o.first_frame != 0 || o.last_frame != UINT32_MAX;
   if (frames == 0) {
-    if (ranged) error = "the clip has no frames";
-    return !ranged;
+    if (o.first_frame != 0 || o.last_frame != UINT32_MAX) invalid("the clip has no frames");
+    return w;
   }
   w.first = o.first_frame;
   w.last = o.last_frame == UINT32_MAX ? frames - 1 : o.last_frame;
   w.frame_time = clip.frame_time();
   if (w.first > w.last || w.last >= frames)
-    error = "frame range " + std::to_string(w.first) + ":" + std::to_string(w.last) + " is not within 0:" +
-            std::to_string(frames - 1);
-  else if (w.last > w.first && !(w.frame_time > 0.0))
-    error = "the clip's frame time is not positive";
-  return error.empty();
+    invalid("frame range " + std::to_string(w.first) + ":" + std::to_string(w.last) + " is not within 0:" +
+            std::to_string(frames - 1));
+  if (w.last > w.first && !(w.frame_time > 0.0)) invalid("the clip's frame time is not positive");
+  return w;
 }
 
 // Frame positions and player times of the --fps keys: every 1/fps s from the range's start
 // (as decode_motion resamples), and the range's end.
-bool resample_positions(const Window& w, double fps, std::vector<double>& positions, std::vector<double>& times,
-                        std::string& error) {
+void resample_positions(const Window& w, double fps, std::vector<double>& positions, std::vector<double>& times) {
   const double duration = double(w.last - w.first) * w.frame_time;
   const double count = std::floor(duration * fps + 1e-6) + 1.0;
-  if (!(count <= kMaxResampledKeys)) {
-    error = "--fps " + json_number(fps) + " over " + json_number(duration) + " s makes too many keys";
-    return false;
-  }
+  if (!(count <= kMaxResampledKeys))
+    throw Error(ErrorKind::limit, "--fps " + json_number(fps) + " over " + json_number(duration) + " s makes too many keys");
   for (uint32_t i = 0; i < uint32_t(count); ++i) {
     const double t = double(i) / fps;
     times.push_back(t);
@@ -69,7 +67,6 @@ bool resample_positions(const Window& w, double fps, std::vector<double>& positi
     times.push_back(duration);
     positions.push_back(double(w.last));
   }
-  return true;
 }
 
 // What percentages are of, as the encoder measures it (encode.h's reference_size): a
@@ -77,10 +74,8 @@ bool resample_positions(const Window& w, double fps, std::vector<double>& positi
 double reference_size(const Clip& clip) {
   const double size = skeleton_size(clip.skeleton());
   const double decoded_bytes = double(clip.frame_count()) * double(clip.channel_count()) * sizeof(double);
-  Motion motion;
-  std::string ignored;
-  if (size > 0.0 || !(decoded_bytes <= kMaxWorkingBytes) || !decode_motion(clip, {}, motion, ignored)) return size;
-  return offline::reference_size(motion);
+  if (size > 0.0 || !(decoded_bytes <= kMaxWorkingBytes)) return size;
+  return offline::reference_size(decode_motion(clip));
 }
 
 std::string extras(const GltfReport& r, const Window& w, double fps) {
@@ -109,8 +104,8 @@ double shell_units(const Clip& clip, const GltfOptions& o, double size) {
 
 // The animation: resampled (--fps) or exact translations and fitted keys; then what a player
 // reaches against the clip.
-bool animate(const Clip& clip, const GltfOptions& options, const Window& w, double size, Model& model,
-             GltfReport& report, std::string& error) {
+void animate(const Clip& clip, const GltfOptions& options, const Window& w, double size, Model& model,
+             GltfReport& report) {
   const Skeleton& sk = model.skeleton;
   std::vector<ChannelCurve> curves;
   for (uint32_t c = 0; c < clip.channel_count(); ++c) curves.emplace_back(clip, c);
@@ -119,7 +114,7 @@ bool animate(const Clip& clip, const GltfOptions& options, const Window& w, doub
   const Reference reference(sk, curves, w, report.shell_distance);
   if (options.fps > 0.0) {
     std::vector<double> positions, times;
-    if (!resample_positions(w, options.fps, positions, times, error)) return false;
+    resample_positions(w, options.fps, positions, times);
     for (size_t j = 0; j < sk.joints.size(); ++j) {
       if (!translation_at_rest(nodes[j], curves))
         model.nodes[j].translation = resampled_translation(nodes[j], curves, positions, times);
@@ -131,8 +126,7 @@ bool animate(const Clip& clip, const GltfOptions& options, const Window& w, doub
       for (size_t j = 0; j < sk.joints.size(); ++j)
         if (!translation_at_rest(nodes[j], curves)) model.nodes[j].translation = translation_sampler(nodes[j], curves, w);
     const double fit_tol = report.tolerance - kRoundingMargin * size;
-    if (!fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, report.rounds, error, options.progress))
-      return false;
+    report.rounds = fit_keys(model, nodes, curves, reference, fit_tol, options.linear_only, options.progress);
   }
   // Every export carries one animation spanning the range, even if nothing moves.
   bool animated = false;
@@ -146,7 +140,6 @@ bool animate(const Clip& clip, const GltfOptions& options, const Window& w, doub
   report.worst_node = reference.owner(check.worst_point);
   report.worst_axis = reference.moved_by_owner(check.worst_point) ? int(check.worst_point - report.nodes) % 3 : -1;
   report.worst_frame = w.first + check.worst_frame_index;
-  return true;
 }
 
 void count_tracks(const Model& model, GltfReport& report) {
@@ -161,13 +154,10 @@ void count_tracks(const Model& model, GltfReport& report) {
 
 }  // namespace
 
-bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
-                 std::string& error) {
-  out = {};
-  report = {};
-  error.clear();
-  Window w;
-  if (!check_options(clip, options, w, error)) return false;
+GltfOutput export_gltf(const Clip& clip, const GltfOptions& options) {
+  GltfOutput out;
+  GltfReport& report = out.report;
+  const Window w = check_options(clip, options);
   Model model;
   model.skeleton = clip.skeleton();
   model.animation_name = options.name;
@@ -175,34 +165,29 @@ bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, 
   report.nodes = uint32_t(model.nodes.size());
   // Per frame and node of the window: reference points, fit targets.
   const double working = double(w.frames()) * double(report.nodes) * (4 * sizeof(Vec3) + 96);
-  if (!(working <= kMaxWorkingBytes)) {
-    error = "the clip is too long for one glTF export (" + std::to_string(w.frames()) + " frames of " +
-            std::to_string(report.nodes) + " nodes): export it in frame ranges";
-    return false;
-  }
+  if (!(working <= kMaxWorkingBytes))
+    throw Error(ErrorKind::limit, "the clip is too long for one glTF export (" + std::to_string(w.frames()) +
+                                      " frames of " + std::to_string(report.nodes) + " nodes): export it in frame ranges");
   const double size = reference_size(clip);
   report.tolerance = tolerance_units(clip, options, size);
   report.shell_distance = shell_units(clip, options, size);
   // Players differ in rounding (float32 or binary64 arithmetic, normalising slerp's result or
   // not): the fit keeps a margin of a few float32 ulps of the skeleton's extent.
   if (clip.frame_count() > 0 && options.fps == 0.0 && !(report.tolerance > kRoundingMargin * size)) {
-    error = report.tolerance > 0.0
-                ? "float32 glTF keys cannot hold the tolerance " + json_number(report.tolerance) +
-                      ": rounding alone reaches " + json_number(kRoundingMargin * size) + " (use a larger --error)"
-                : "the tolerance is 0 (the skeleton has no extent): give one in length units with --error";
-    return false;
+    if (report.tolerance > 0.0)
+      throw Error(ErrorKind::limit, "float32 glTF keys cannot hold the tolerance " + json_number(report.tolerance) +
+                                        ": rounding alone reaches " + json_number(kRoundingMargin * size) +
+                                        " (use a larger --error)");
+    invalid("the tolerance is 0 (the skeleton has no extent): give one in length units with --error");
   }
-  if (clip.frame_count() > 0 && !animate(clip, options, w, size, model, report, error)) return false;
+  if (clip.frame_count() > 0) animate(clip, options, w, size, model, report);
   count_tracks(model, report);
   model.extras_json = extras(report, w, options.fps);
   if (options.bin_uri.empty()) out.main = write_glb(model);
   else write_gltf(model, options.bin_uri, out.main, out.bin);
-  if (out.main.size() + out.bin.size() >= (uint64_t(1) << 32)) {  // GLB and glTF lengths are u32
-    out = {};
-    error = "the glTF asset would exceed 4 GiB: export it in frame ranges";
-    return false;
-  }
-  return true;
+  if (out.main.size() + out.bin.size() >= (uint64_t(1) << 32))  // GLB and glTF lengths are u32
+    throw Error(ErrorKind::limit, "the glTF asset would exceed 4 GiB: export it in frame ranges");
+  return out;
 }
 
 }  // namespace keyanim::offline

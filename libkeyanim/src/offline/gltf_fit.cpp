@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "gltf_player.h"
+#include "keyanim/offline/error.h"
 
 namespace keyanim::offline::gltf {
 namespace {
@@ -227,9 +228,9 @@ std::string describe_failure(const Skeleton& sk, const Reference& ref, const Che
 
 }  // namespace
 
-bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
-              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error,
-              const std::function<void(EncodeStage, double)>& progress) {
+uint32_t fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
+                  const Reference& reference, double tolerance, bool linear_only,
+                  const std::function<void(EncodeStage, double)>& progress) {
   const Skeleton& sk = model.skeleton;
   const Window& w = reference.window();
   std::vector<Target> targets;
@@ -250,7 +251,7 @@ bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vec
   const auto report = [&](EncodeStage stage, double f) {
     if (progress) progress(stage, f);
   };
-  for (rounds = 1;; ++rounds) {
+  for (uint32_t rounds = 1;; ++rounds) {
     const size_t todo = size_t(std::count(refit.begin(), refit.end(), true));
     size_t done = 0;
     for (size_t i = 0; i < targets.size(); ++i) {
@@ -261,7 +262,7 @@ bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vec
     }
     report(EncodeStage::fitting, 1.0);
     const CheckResult r = check_model(model, reference, tolerance, [&](double f) { report(EncodeStage::verifying, f); });
-    if (r.violations.empty()) return true;
+    if (r.violations.empty()) return rounds;
     refit = blame(r.violations, targets, target_of, sk, reference);
     bool any = false;
     for (size_t i = 0; i < targets.size(); ++i) {
@@ -273,10 +274,7 @@ bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vec
       targets[i].budget *= kTighten;
       targets[i].every_frame = rounds >= kMaxRounds;
     }
-    if (!any) {
-      error = describe_failure(sk, reference, r, tolerance);
-      return false;
-    }
+    if (!any) throw Error(ErrorKind::limit, describe_failure(sk, reference, r, tolerance));
   }
 }
 

@@ -4,7 +4,6 @@
 // too, within a local distance. The local budgets are tightened where forward kinematics of what
 // a glTF player computes strays beyond the tolerance.
 #pragma once
-#include <string>
 #include <vector>
 
 #include "gltf_curves.h"
@@ -16,10 +15,10 @@ namespace keyanim::offline::gltf {
 // Sets model.nodes[j].rotation for every node j whose rotation is not always the identity (and,
 // with linear_only, .translation for every node whose translation leaves its OFFSET), so that
 // check_model(model, reference, tolerance) finds no violation. Other tracks already in the model
-// stay. Returns false with `error` if float32 keys cannot hold the tolerance. `rounds` receives
-// the number of verification rounds. `progress` as GltfOptions::progress (fitting, verifying).
-bool fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
-              const Reference& reference, double tolerance, bool linear_only, uint32_t& rounds, std::string& error,
-              const std::function<void(EncodeStage, double)>& progress = {});
+// stay. Returns the number of verification rounds; throws Error (limit) if float32 keys cannot
+// hold the tolerance. `progress` as GltfOptions::progress (fitting, verifying).
+uint32_t fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std::vector<ChannelCurve>& curves,
+                  const Reference& reference, double tolerance, bool linear_only,
+                  const std::function<void(EncodeStage, double)>& progress = {});
 
 }  // namespace keyanim::offline::gltf

@@ -1,6 +1,9 @@
 #include "keyanim/offline/keyframes.h"
 
 #include <algorithm>
+#include <string>
+
+#include "keyanim/offline/error.h"
 
 namespace keyanim::offline {
 
@@ -16,25 +19,20 @@ std::vector<uint32_t> uniform_keys(uint32_t frame_count, uint32_t interval) {
   return keys;
 }
 
-bool manual_keys(std::vector<uint32_t> frames, uint32_t frame_count, std::vector<uint32_t>& out,
-                 std::string& error) {
-  out.clear();
+std::vector<uint32_t> manual_keys(std::vector<uint32_t> frames, uint32_t frame_count) {
   for (const uint32_t f : frames) {
-    if (f >= frame_count) {
-      error = frame_count == 0
-                  ? "key frame " + std::to_string(f) + " given, but the motion has no frames"
-                  : "key frame " + std::to_string(f) + " is out of range [0, " +
-                        std::to_string(frame_count - 1) + "]";
-      return false;
-    }
+    if (f >= frame_count)
+      throw Error(ErrorKind::invalid_argument,
+                  frame_count == 0 ? "key frame " + std::to_string(f) + " given, but the motion has no frames"
+                                   : "key frame " + std::to_string(f) + " is out of range [0, " +
+                                         std::to_string(frame_count - 1) + "]");
   }
-  if (frame_count == 0) return true;
+  if (frame_count == 0) return {};
   frames.push_back(0);
   frames.push_back(frame_count - 1);
   std::sort(frames.begin(), frames.end());
   frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
-  out = std::move(frames);
-  return true;
+  return frames;
 }
 
 }  // namespace keyanim::offline

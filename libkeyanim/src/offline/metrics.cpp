@@ -183,16 +183,17 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded, double 
   const size_t nodes = original.skeleton.joints.size();
   const uint32_t channels = original.channel_count();
   const uint32_t frames = original.frame_count;
-  if (decoded.channel_count() != channels || decoded.frame_count != frames ||
-      decoded.skeleton.joints.size() != nodes || !usable(original) || !usable(decoded)) {
-    ErrorReport report;
-    report.max_error = report.rms_error = kInf;
-    report.reading_max = {kInf, kInf};
-    report.shell = shell;
-    report.joint_max.assign(nodes, kInf);
-    report.channel_max.assign(channels, kInf);
-    return report;
-  }
+  if (decoded.channel_count() != channels || decoded.frame_count != frames || decoded.skeleton.joints.size() != nodes)
+    throw Error(ErrorKind::invalid_argument,
+                "cannot compare motions that differ in frames, channels or nodes (" + std::to_string(frames) + ", " +
+                    std::to_string(channels) + ", " + std::to_string(nodes) + " against " +
+                    std::to_string(decoded.frame_count) + ", " + std::to_string(decoded.channel_count()) + ", " +
+                    std::to_string(decoded.skeleton.joints.size()) + ")");
+  if (!usable(original) || !usable(decoded))
+    throw Error(ErrorKind::invalid_argument, "a motion's values do not fill frames x channels, or its channel "
+                                             "columns lie outside a frame");
+  if (!(shell >= 0.0 && std::isfinite(shell)))
+    throw Error(ErrorKind::invalid_argument, "the shell distance must be 0 or more and finite, got " + std::to_string(shell));
   // Window by window, as a caller measuring in parallel does, so that both agree to the bit.
   ErrorAccumulator total(original.skeleton, shell, &decoded.skeleton);
   const uint32_t window = measure_window(frames);

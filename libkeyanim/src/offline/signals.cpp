@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "keyanim/offline/encode.h"
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
 #include "offline/parallel.h"
 
@@ -16,12 +17,14 @@ constexpr uint32_t kCheckWindow = 256;  // frames per FK job
 
 }  // namespace
 
-std::string check_motion(const Motion& m, unsigned threads) {
+void check_motion(const Motion& m, unsigned threads) {
   const uint32_t n_ch = m.channel_count();
   if (m.values.size() != size_t(n_ch) * m.frame_count)
-    return "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels";
+    throw Error(ErrorKind::invalid_argument,
+                "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels");
   for (double v : m.values)
-    if (!(std::fabs(v) <= kMaxMagnitude)) return "a channel value is beyond what binary32 keys can hold (|v| > 1e37)";
+    if (!(std::fabs(v) <= kMaxMagnitude))
+      throw Error(ErrorKind::malformed, "a channel value is beyond what binary32 keys can hold (|v| > 1e37)");
   const size_t windows = (size_t(m.frame_count) + kCheckWindow - 1) / kCheckWindow;
   std::vector<uint8_t> overflow(windows, 0);
   parallel_for(windows, threads, [&](size_t w, unsigned) {
@@ -39,8 +42,7 @@ std::string check_motion(const Motion& m, unsigned threads) {
     }
   });
   if (std::find(overflow.begin(), overflow.end(), 1) != overflow.end())
-    return "joint positions overflow (beyond 1e37 in file units)";
-  return {};
+    throw Error(ErrorKind::malformed, "joint positions overflow (beyond 1e37 in file units)");
 }
 
 ChannelLayout channel_layout(const Skeleton& s) {

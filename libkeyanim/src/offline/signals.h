@@ -3,17 +3,16 @@
 // encoder; unwrap_degrees and reference_size are public (encode.h).
 #pragma once
 #include <cstdint>
-#include <string>
 #include <vector>
 
 #include "keyanim/offline/motion.h"
 
 namespace keyanim::offline {
 
-// Empty if `motion` can be encoded, else why: values and frames x channels disagree, a value
-// or a joint position is beyond what binary32 keys can hold. Positions are checked by FK,
-// frame windows on `threads` threads.
-std::string check_motion(const Motion& motion, unsigned threads);
+// Throws Error unless `motion` can be encoded: values and frames x channels disagree
+// (invalid_argument), a value or a joint position is beyond what binary32 keys can hold
+// (malformed). Positions are checked by FK, frame windows on `threads` threads.
+void check_motion(const Motion& motion, unsigned threads);
 
 // Per channel: the node it belongs to, and whether it is a rotation.
 struct ChannelLayout {

@@ -102,12 +102,11 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
   return k == n ? Status::ok : Status::invalid_argument;  // k < n cannot happen for a loaded clip
 }
 
-float Clip::sample_channel(uint32_t c, float frame_position) const noexcept {
+Status Clip::sample_channel(uint32_t c, float frame_position, float& out) const noexcept {
   const Image& img = KEYANIM_IMG;
-  if (c >= img.interp.size() || std::isnan(frame_position)) return 0.0f;
-  float v = 0.0f;
-  internal::sample_listed(img, frame_position, &c, 1, &v);
-  return v;
+  if (c >= img.interp.size() || std::isnan(frame_position)) return Status::invalid_argument;
+  internal::sample_listed(img, frame_position, &c, 1, &out);
+  return Status::ok;
 }
 
 // ---- Sampling

@@ -8,18 +8,10 @@
 #include <string_view>
 #include <vector>
 
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/motion.h"
 
 namespace keyanim::offline {
-
-struct BvhError {
-  std::string file;      // as given by the caller
-  uint32_t line = 0;     // 1-based; 0 when the error is not about a place in the text
-  uint32_t column = 0;   // 1-based byte column
-  std::string message;   // "expected ..., found ..."
-  // "file:line:column: message"
-  std::string to_string() const;
-};
 
 struct BvhReadOptions {
   uint32_t max_joints = 1u << 16;  // Defaults to 65536 nodes; more is an error, not an allocation.
@@ -29,9 +21,10 @@ struct BvhReadOptions {
   std::function<void(double fraction)> progress;
 };
 
-// Parses BVH text. On success fills `out` and appends any warnings (e.g. more motion lines than
-// `Frames:` declares: all lines are kept) to `warnings`. On failure returns false, fills `err` and
-// leaves `out` empty. What is accepted:
+// Parses BVH text into a motion, appending any warnings (e.g. more motion lines than `Frames:`
+// declares: all lines are kept) to `warnings`. Throws Error (kind malformed, or limit past
+// `options`) at the 1-based line and byte column of the offending token, the message being
+// "expected X, found Y". What is accepted:
 //  - one or more ROOT blocks (a forest: every root has parent -1); JOINT; End Site, optionally
 //    followed by a name (kept in Joint::name); a joint without children or without CHANNELS;
 //  - OFFSET and CHANNELS (0..6 distinct channels in any order) before a block's children;
@@ -43,12 +36,11 @@ struct BvhReadOptions {
 //  - one frame per line (trailing blanks allowed). More lines than `Frames:` declares: all are
 //    kept, with a warning; fewer: an error naming both numbers. Nothing is allocated from the
 //    declared count beyond what the remaining text could hold.
-// Errors are "expected X, found Y" at the 1-based line and byte column of the offending token.
-bool read_bvh(std::string_view text, const std::string& file_name, Motion& out, BvhError& err,
-              std::vector<std::string>* warnings = nullptr, const BvhReadOptions& options = {});
-// Reads a whole file and parses it; I/O failures are reported with line 0.
-bool read_bvh_file(const std::string& path, Motion& out, BvhError& err,
-                   std::vector<std::string>* warnings = nullptr, const BvhReadOptions& options = {});
+Motion read_bvh(std::string_view text, const std::string& file_name, std::vector<std::string>* warnings = nullptr,
+                const BvhReadOptions& options = {});
+// Reads a whole file and parses it; a file that cannot be read throws Error (io, with errno).
+Motion read_bvh_file(const std::string& path, std::vector<std::string>* warnings = nullptr,
+                     const BvhReadOptions& options = {});
 
 // BVH text with LF line endings and tab indentation (at most kMaxIndent tabs, so that the text
 // stays linear in the node count however deep the hierarchy: readers do not need indentation);
@@ -74,9 +66,9 @@ class BvhWriter {
   BvhWriter& operator=(const BvhWriter&) = delete;
   // One frame: the skeleton's channel_count() values in column order (as Motion::frame()).
   void frame(const double* values);
-  // Hands what is left to the sink. False if the frames given differ from the declared count
-  // (the text is then not valid BVH).
-  bool finish();
+  // Hands what is left to the sink. Throws Error (invalid_argument) if the frames given differ
+  // from the declared count (the text is then not valid BVH).
+  void finish();
 
  private:
   void flush();

@@ -9,16 +9,17 @@
 
 namespace keyanim::offline {
 
-// Empty if `clip` can be written (it follows every rule of spec/FORMAT.md: key frames strictly
+// Returns if `clip` can be written (it follows every rule of spec/FORMAT.md: key frames strictly
 // increasing and below frame_count, |q| <= 2^53, finite values, step > 0, tension in [-1, 1],
-// parents before children, End Sites without channels ...), else the first rule it breaks.
-std::string validate_encoded_clip(const EncodedClip& clip);
+// parents before children, End Sites without channels ...); else throws Error
+// (invalid_argument) naming the first rule it breaks.
+void validate_encoded_clip(const EncodedClip& clip);
 
 // The complete file: signature, header, section table, sections, CRC-32. Each section is a
 // zstd frame at `zstd_level` (clamped to at most zstd's maximum) when that is smaller, else
 // stored raw; zstd_level <= 0 stores every section raw. Sections are compressed on up to
-// `threads` threads (0: one per core); the bytes do not depend on it. Returns an empty vector
-// if validate_encoded_clip(clip) is not empty.
+// `threads` threads (0: one per core); the bytes do not depend on it. Throws as
+// validate_encoded_clip(clip).
 std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level = 19, unsigned threads = 1);
 
 // The clip a decoder builds from write_kanim(clip), without the bytes: the encoder verifies

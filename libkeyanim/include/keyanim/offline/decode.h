@@ -3,10 +3,10 @@
 #pragma once
 #include <cstdint>
 #include <span>
-#include <string>
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/motion.h"
 
 namespace keyanim::offline {
@@ -32,11 +32,11 @@ struct ResampleOptions {
 // before producing any.
 class FrameDecoder {
  public:
-  // Checks `options` against `clip` (which must outlive the decoder). Fails (returns false,
-  // `error` says why) only for options that make no sense: fps < 0 or not finite, both fps and
+  // Checks `options` against `clip` (which must outlive the decoder). Throws Error
+  // (invalid_argument) only for options that make no sense: fps < 0 or not finite, both fps and
   // inbetweens, fps for a clip without frame time, an empty or reversed range, last_frame
   // beyond the clip. Any number of output frames is accepted here.
-  bool start(const Clip& clip, const ResampleOptions& options, std::string& error);
+  void start(const Clip& clip, const ResampleOptions& options);
   uint64_t frame_count() const noexcept { return count_; }
   double frame_time() const noexcept { return frame_time_; }
   // Output frame i < frame_count(): clip.channel_count() values. Fastest in increasing i.
@@ -52,8 +52,8 @@ class FrameDecoder {
   Cursor cursor_;
 };
 
-// All frames of a FrameDecoder as one Motion. Fails as FrameDecoder::start, and also when the
-// result would have 2^32 frames or more, or more than 2^40 values.
-bool decode_motion(const Clip& clip, const ResampleOptions& options, Motion& out, std::string& error);
+// All frames of a FrameDecoder as one Motion. Throws as FrameDecoder::start, and Error (limit)
+// when the result would have 2^32 frames or more, or more than 2^40 values.
+Motion decode_motion(const Clip& clip, const ResampleOptions& options = {});
 
 }  // namespace keyanim::offline

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "keyanim/cardinal.h"
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/motion.h"
 
@@ -50,8 +51,8 @@ struct EncodeSettings {
   // on it.
   std::function<void(EncodeStage stage, double fraction)> progress;
 
-  // Empty if valid, else what is wrong.
-  std::string validate() const;
+  // Throws Error (invalid_argument) saying what is wrong, if anything.
+  void validate() const;
 };
 
 // One channel as the container stores it.
@@ -81,8 +82,12 @@ struct EncodeResult {
   uint32_t iterations = 0;    // verify-and-tighten rounds (error mode)
 };
 
-// Returns false with `error` set for invalid settings or a motion the codec cannot take.
-bool encode(const Motion& motion, const EncodeSettings& settings, EncodeResult& out, std::string& error);
+// The motion encoded. Throws Error: invalid_argument for settings that make no sense (validate),
+// a manual key frame beyond the motion, or a tolerance in percent for a skeleton without
+// extent; malformed for a motion the codec cannot take or a clip no .kanim may hold (a frame
+// time of 0 with several frames; a value whose key overflows in the fixed-key modes); limit
+// when the tolerance cannot be reached (below binary32 precision).
+EncodeResult encode(const Motion& motion, const EncodeSettings& settings);
 
 // What a tolerance in percent is a percent of: the skeleton size (fk.h), or for a skeleton with
 // no extent (a lone root) the largest side of the box its nodes sweep over the clip.

@@ -29,8 +29,9 @@ class Error : public std::exception {
  public:
   // A failure that is not about a place in a file.
   Error(ErrorKind kind, std::string message, std::string file = {});
-  // A place in BVH text: 1-based line and byte column.
-  static Error bvh(std::string file, uint32_t line, uint32_t column, std::string message);
+  // A place in BVH text: 1-based line and byte column (line 0: not about a place in the text).
+  static Error bvh(std::string file, uint32_t line, uint32_t column, std::string message,
+                   ErrorKind kind = ErrorKind::malformed);
   // A .kanim the loader refused (ErrorInfo from Clip::load): its section, offset and status.
   static Error kanim(std::string file, const ErrorInfo& info);
   // A system call failed on `file`: `what` ("cannot open file") and errno's text.

@@ -76,8 +76,8 @@ void sin_cos_deg(double deg, double& s, double& c) noexcept;
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
                 std::vector<Mat3>& rotations, PositionReading reading = PositionReading::replace);
 
-// World positions for every frame: result[f * node_count + j]. Frames that `values` is too
-// short to hold are filled with NaN.
+// World positions for every frame: result[f * node_count + j]. Throws Error (invalid_argument)
+// if the values do not fill frames x channels or the channel columns are not consistent.
 std::vector<Vec3> world_positions_all(const Motion& motion, PositionReading reading = PositionReading::replace);
 
 // True when a node other than a root has position channels: then the two readings of them

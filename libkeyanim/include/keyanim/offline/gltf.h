@@ -27,6 +27,7 @@
 #include <string>
 
 #include "keyanim/clip.h"
+#include "keyanim/offline/error.h"
 
 namespace keyanim::offline {
 
@@ -84,14 +85,15 @@ struct GltfReport {
 struct GltfOutput {
   std::string main;  // the .glb, or the .gltf JSON when options.bin_uri is set
   std::string bin;   // the .bin buffer of a .gltf (may be empty: then no buffer is referenced)
+  GltfReport report;
 };
 
-// Builds the asset. Returns false (and says why in `error`, `out` left empty) for options that
-// make no sense (tolerance or fps not positive and finite, shell_percent not finite, an empty or
-// reversed frame range, last_frame beyond the clip), a clip whose frame time is not positive
-// while it has several frames, a tolerance that float32 keys cannot hold, or a range too long
-// for one asset (working memory above 1 GiB, more than 2^24 resampled keys, 4 GiB of output).
-bool export_gltf(const Clip& clip, const GltfOptions& options, GltfOutput& out, GltfReport& report,
-                 std::string& error);
+// Builds the asset. Throws Error: invalid_argument for options that make no sense (tolerance or
+// fps not positive and finite, shell_percent not finite, an empty or reversed frame range,
+// last_frame beyond the clip, a tolerance of 0 for a skeleton without extent) and for a clip
+// whose frame time is not positive while it has several frames; limit for a tolerance that
+// float32 keys cannot hold, or a range too long for one asset (working memory above 1 GiB,
+// more than 2^24 resampled keys, 4 GiB of output).
+GltfOutput export_gltf(const Clip& clip, const GltfOptions& options);
 
 }  // namespace keyanim::offline

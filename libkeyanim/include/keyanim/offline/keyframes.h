@@ -2,7 +2,6 @@
 // (Curvature feature points: curvature.h. Error-bounded selection: encode.h.)
 #pragma once
 #include <cstdint>
-#include <string>
 #include <vector>
 
 namespace keyanim::offline {
@@ -10,9 +9,8 @@ namespace keyanim::offline {
 // 0, N, 2N, ... and the last frame. interval >= 1.
 std::vector<uint32_t> uniform_keys(uint32_t frame_count, uint32_t interval);
 
-// The user's frames, sorted, duplicates removed, with the first and last frame added. Returns
-// false and says why in `error` if a frame is out of range.
-bool manual_keys(std::vector<uint32_t> frames, uint32_t frame_count, std::vector<uint32_t>& out,
-                 std::string& error);
+// The user's frames, sorted, duplicates removed, with the first and last frame added. Throws
+// Error (invalid_argument) if a frame is out of range.
+std::vector<uint32_t> manual_keys(std::vector<uint32_t> frames, uint32_t frame_count);
 
 }  // namespace keyanim::offline

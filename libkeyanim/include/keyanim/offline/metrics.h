@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "keyanim/offline/error.h"
 #include "keyanim/offline/motion.h"
 #include "keyanim/pose.h"
 
@@ -41,8 +42,9 @@ struct ErrorReport {
   std::vector<double> channel_max;  // per channel: length units, or degrees (compared modulo 360)
 };
 
-// Both motions must share the skeleton and frame count. The shell distance is in file units;
-// without it, kDefaultShellPercent of the original's reference size.
+// Both motions must share the skeleton's layout (nodes and channels) and the frame count, and
+// their values must fill frames x channels, and the shell distance (file units) must be finite
+// and 0 or more; else throws Error (invalid_argument). Without a shell distance, kDefaultShellPercent of the original's reference size.
 ErrorReport measure_error(const Motion& original, const Motion& decoded, double shell);
 ErrorReport measure_error(const Motion& original, const Motion& decoded);
 // kDefaultShellPercent of reference_size(motion), in file units.
