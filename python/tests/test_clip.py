@@ -9,7 +9,8 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import HOP, WALK, cli, cli_json, corpus_files, local_rotations, parse_bvh, quaternion_matrices, world_positions
+from conftest import (HOP, WALK, cli, cli_json, corpus_files, local_rotations, local_translations, parse_bvh,
+                      quaternion_matrices, world_positions)
 
 F = np.float32
 
@@ -121,7 +122,6 @@ def test_local_transforms_match_independent_rotations(walk, walk_bvh, walk_clip)
     decoded = walk_clip.sample_frames(frames).astype(np.float64)
     np.testing.assert_allclose(np.linalg.norm(q, axis=-1), 1.0, atol=1e-6)
     np.testing.assert_allclose(quaternion_matrices(q.astype(np.float64)), local_rotations(walk_bvh, decoded), atol=2e-6)
-    from conftest import local_translations
     np.testing.assert_allclose(t, local_translations(walk_bvh, decoded), rtol=1e-6, atol=1e-5)
     # By time, the same; and 'add' adds the OFFSET to the root's position channels.
     q2, t2 = walk_clip.local_transforms(frames * walk_clip.frame_time)
@@ -267,4 +267,16 @@ def test_corpus_clips(keyanim, path, tmp_path):
     want = world_positions(bvh, rows.astype(np.float64))
     size = max(report["tolerance"] / 0.005, 1.0)
     np.testing.assert_allclose(clip.world_positions(frames=positions), want, rtol=0, atol=1e-5 * size)
+    q, t = clip.local_transforms(frames=positions)
+    np.testing.assert_allclose(quaternion_matrices(q.astype(np.float64)), local_rotations(bvh, rows.astype(np.float64)),
+                               atol=5e-6)
+    np.testing.assert_allclose(t, local_translations(bvh, rows.astype(np.float64)), rtol=1e-6, atol=1e-6 * size)
+    if clip.frame_time > 0:
+        times = positions * clip.frame_time
+        np.testing.assert_allclose(clip.sample(times), rows, rtol=1e-5, atol=1e-5)
+        m30 = clip.to_motion(fps=30)
+        assert m30.frame_count == int(np.floor((n - 1) * clip.frame_time * 30 + 1e-6)) + 1
     assert np.array_equal(clip.to_motion().channels, clip.sample_frames(np.arange(float(n))).astype(np.float64))
+    path = tmp_path / "clip.kanim"
+    path.write_bytes(data)
+    assert keyanim.Clip(path).info == cli_json("info", path, "--json")

@@ -130,3 +130,4 @@ def test_corpus_encode_within_tolerance(keyanim, path):
     err = independent_error(bvh, clip)
     assert err <= report["tolerance"] * (1 + 1e-9)
     assert report["kanim_bytes"] == len(data) and report["frames"] == m.frame_count
+    assert keyanim.measure_error(m, clip.to_motion()) == report["error"]

@@ -138,6 +138,10 @@ def test_local_quaternions_match_independent_rotations(walk, walk_bvh):
     np.testing.assert_allclose(quaternion_matrices(q), local_rotations(walk_bvh, walk_bvh.values), atol=1e-12)
     assert np.array_equal(q[:, walk.is_end_site], np.tile([0.0, 0.0, 0.0, 1.0], (344, 7, 1)))
     assert np.array_equal(walk.local_quaternions([3]), q[[3]])
+    with pytest.raises(IndexError):
+        walk.local_quaternions([0, 344])
+    with pytest.raises(TypeError):
+        walk.local_quaternions("all")
 
 
 def test_measure_error(keyanim, walk, walk_encoded, walk_clip):
@@ -160,6 +164,8 @@ def test_corpus_read_exactly(keyanim, path, tmp_path):
     check_against_text(m, bvh)
     np.testing.assert_allclose(m.world_positions(), world_positions(bvh, bvh.values), rtol=0,
                                atol=1e-9 * max(1.0, np.abs(bvh.offsets).max()))
+    np.testing.assert_allclose(quaternion_matrices(m.local_quaternions()), local_rotations(bvh, bvh.values),
+                               atol=1e-12)
     out = tmp_path / "again.bvh"
     m.write_bvh(out)
     assert np.array_equal(keyanim.read_bvh(out).channels, m.channels)
