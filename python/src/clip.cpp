@@ -119,6 +119,7 @@ const char* const kClipDoc =
 
 void register_clip(py::module_& m) {
   py::class_<PyClip, std::shared_ptr<PyClip>> cls(m, "Clip", kClipDoc);
+  cls.attr("__module__") = "keyanim";  // as users import it (signatures say keyanim.Clip)
   cls.def(py::init(&load), py::arg("path_or_bytes"),
           "Loads a .kanim from a path (str or os.PathLike) or from bytes (bytes, bytearray,\n"
           "memoryview).");
@@ -160,18 +161,18 @@ void register_clip(py::module_& m) {
       "A dict with the keys of `keyanim info --json` (version, frames, frame_time, joints,\n"
       "channels, size, keys per channel, tensions, memory_bytes, encoder_notes, ...).");
   cls.def(
-      "sample", [](const PyClip& c, const py::handle& times) { return sample(c, where(c, times, py::none())); },
+      "sample", [](const PyClip& c, const py::object& times) { return sample(c, where(c, times, py::none())); },
       py::arg("times"),
       "Every channel at each time in seconds: float32 array times.shape + (channels,). Times\n"
       "are clamped to the clip; between frames the values are in-betweens.");
   cls.def(
-      "sample_frames", [](const PyClip& c, const py::handle& frames) { return sample(c, where(c, py::none(), frames)); },
+      "sample_frames", [](const PyClip& c, const py::object& frames) { return sample(c, where(c, py::none(), frames)); },
       py::arg("frames"),
       "Every channel at each frame position (fractional positions are in-betweens): float32\n"
       "array frames.shape + (channels,).");
   cls.def(
       "local_transforms",
-      [](const PyClip& c, const py::handle& times, const py::handle& frames, const std::string& reading) {
+      [](const PyClip& c, const py::object& times, const py::object& frames, const std::string& reading) {
         auto [q, t] = transforms(c, where(c, times, frames), false, reading_arg(reading), true);
         return py::make_tuple(q, t);
       },
@@ -184,7 +185,7 @@ void register_clip(py::module_& m) {
       "or 'add' (three.js).");
   cls.def(
       "world_positions",
-      [](const PyClip& c, const py::handle& times, const py::handle& frames, const std::string& reading) {
+      [](const PyClip& c, const py::object& times, const py::object& frames, const std::string& reading) {
         return transforms(c, where(c, times, frames), true, reading_arg(reading), false).second;
       },
       py::arg("times") = py::none(), py::kw_only(), py::arg("frames") = py::none(),
@@ -219,7 +220,7 @@ void register_clip(py::module_& m) {
       "exactly as the sampler uses them. No keys: the channel is 0 throughout; one: constant.");
   cls.def(
       "to_motion",
-      [](const PyClip& c, const py::handle& fps) {
+      [](const PyClip& c, const py::object& fps) {
         offline::ResampleOptions options;
         if (!fps.is_none()) options.fps = fps.cast<double>();
         auto out = std::make_shared<PyMotion>();

@@ -83,7 +83,7 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
   s.validate();
 }
 
-py::tuple encode(const PyMotion& m, const py::handle& error, const py::handle& keys, const py::kwargs& kwargs) {
+py::tuple encode(const PyMotion& m, const py::object& error, const py::object& keys, const py::kwargs& kwargs) {
   offline::EncodeSettings settings;
   settings.threads = 0;  // as `keyanim encode` does for one file: one thread per core
   set_tolerance(error, settings);

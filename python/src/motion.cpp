@@ -19,7 +19,7 @@ namespace {
 
 // BVH text of `path` as a Motion; warnings (more motion lines than Frames: declares) are
 // Python warnings.
-PyMotion read(const py::handle& path_arg) {
+PyMotion read(const py::object& path_arg) {
   PyMotion m;
   m.source = path_of(path_arg);
   std::vector<std::string> warnings;
@@ -89,6 +89,7 @@ const char* const kMotionDoc =
 
 void register_motion(py::module_& m) {
   py::class_<PyMotion, std::shared_ptr<PyMotion>> cls(m, "Motion", kMotionDoc);
+  cls.attr("__module__") = "keyanim";  // as users import it (signatures say keyanim.Motion)
   cls.def_property_readonly("frame_count", [](const PyMotion& self) { return self.motion.frame_count; },
                             "Number of frames.");
   cls.def_property_readonly("frame_time", [](const PyMotion& self) { return self.motion.frame_time; },
@@ -119,7 +120,7 @@ void register_motion(py::module_& m) {
   def_skeleton_properties(cls, [](const PyMotion& self) -> const Skeleton& { return self.motion.skeleton; });
   cls.def(
       "write_bvh",
-      [](const PyMotion& self, const py::handle& path, bool overwrite) {
+      [](const PyMotion& self, const py::object& path, bool overwrite) {
         const std::string p = path_of(path);
         py::gil_scoped_release unlocked;
         write_bvh_file(self.motion, p, overwrite);
@@ -130,7 +131,7 @@ void register_motion(py::module_& m) {
       "with overwrite=True (else FileExistsError).");
   cls.def(
       "world_positions",
-      [](const PyMotion& self, const py::handle& frames) {
+      [](const PyMotion& self, const py::object& frames) {
         return per_node(self, frames, 3, [&](const double* row, double* out) {
           thread_local std::vector<offline::Vec3> pos;
           offline::world_positions(self.motion.skeleton, row, pos);
@@ -143,7 +144,7 @@ void register_motion(py::module_& m) {
       "or an array of ints (negative ones count from the end).");
   cls.def(
       "local_quaternions",
-      [](const PyMotion& self, const py::handle& frames) {
+      [](const PyMotion& self, const py::object& frames) {
         return per_node(self, frames, 4, [&](const double* row, double* out) {
           for (const Joint& j : self.motion.skeleton.joints) {
             const offline::Quat q = offline::local_quaternion(j, row);
