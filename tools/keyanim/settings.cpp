@@ -39,12 +39,11 @@ void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const 
 }
 
 void parse_shell(const std::string& text, offline::EncodeSettings& s, const std::string& option) {
-  std::string t = text;
-  s.shell_in_percent = !t.empty() && t.back() == '%';
-  if (s.shell_in_percent) t.pop_back();
-  s.shell = parse_double(option, t);
-  if (!(s.shell >= 0.0)) fail(kUsage, option + " must be 0 or more, got '" + text + "'");
-  if (s.shell == 0.0) s.shell_in_percent = false;  // "0" and "0%" alike
+  try {
+    offline::parse_shell(text, s);
+  } catch (const offline::Error& e) {
+    fail(kUsage, option + ": " + e.message());
+  }
 }
 
 void parse_key_mode(const std::string& text, offline::EncodeSettings& s) {

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "keyanim/offline/error.h"
 
@@ -21,9 +22,8 @@ uint32_t whole_uint(std::string_view text, const char* what) {
   return v;
 }
 
-}  // namespace
-
-void parse_tolerance(std::string_view text, EncodeSettings& settings) {
+// "N" or "N%" as a finite number and whether it is a percentage; `what` names it in errors.
+std::pair<double, bool> number_or_percent(std::string_view text, const char* what, const char* example) {
   std::string_view number = text;
   const bool percent = !number.empty() && number.back() == '%';
   if (percent) number.remove_suffix(1);
@@ -31,11 +31,27 @@ void parse_tolerance(std::string_view text, EncodeSettings& settings) {
   const char* end = number.data() + number.size();
   const auto [p, ec] = std::from_chars(number.data(), end, v);
   if (number.empty() || ec != std::errc() || p != end || !std::isfinite(v))
-    invalid("the tolerance expects a number (units) or a percentage such as 0.05%, got '" + std::string(text) + "'");
+    invalid(std::string(what) + " expects a number (units) or a percentage such as " + example + ", got '" +
+            std::string(text) + "'");
+  if (percent && v > 100.0)
+    invalid(std::string(what) + " in percent must be at most 100, got '" + std::string(text) + "'");
+  return {v, percent};
+}
+
+}  // namespace
+
+void parse_tolerance(std::string_view text, EncodeSettings& settings) {
+  const auto [v, percent] = number_or_percent(text, "the tolerance", "0.05%");
   if (!(v > 0.0)) invalid("the tolerance must be positive, got '" + std::string(text) + "'");
-  if (percent && v > 100.0) invalid("the tolerance in percent must be at most 100, got '" + std::string(text) + "'");
   settings.tolerance = v;
   settings.tolerance_in_percent = percent;
+}
+
+void parse_shell(std::string_view text, EncodeSettings& settings) {
+  const auto [v, percent] = number_or_percent(text, "the shell distance", "2%");
+  if (!(v >= 0.0)) invalid("the shell distance must be 0 or more, got '" + std::string(text) + "'");
+  settings.shell = v;
+  settings.shell_in_percent = percent && v > 0.0;  // "0" and "0%" alike
 }
 
 void parse_key_mode(std::string_view text, EncodeSettings& settings) {
