@@ -59,7 +59,7 @@ class Dataset:
       "local_quaternions"   float32 (window, nodes, 4): local rotations (x, y, z, w)
       "local_translations"  float32 (window, nodes, 3)
       "world_positions"     float32 (window, nodes, 3)
-    position_reading: "replace" (default) or "add", as Clip.local_transforms.
+    position_channels: "replace" (default) or "add", as Clip.local_transforms.
     workers: threads that load the files (default: one per core; loading releases the GIL).
 
     len(dataset) counts the windows; dataset[i] samples only the window's frames of one clip
@@ -70,9 +70,9 @@ class Dataset:
     """
 
     def __init__(self, paths_or_directory, fps=None, window=64, stride=None, output="channels",
-                 position_reading="replace", workers=None):
+                 position_channels="replace", workers=None):
         self._settings = dict(fps=fps, window=window, stride=stride, output=output,
-                              position_reading=position_reading, workers=workers)
+                              position_channels=position_channels, workers=workers)
         self.paths = _collect(paths_or_directory)
         if not self.paths:
             raise ValueError("no .kanim or .bvh files in %r" % (paths_or_directory,))
@@ -89,11 +89,11 @@ class Dataset:
                 raise ValueError("output %r is not one of %s" % (name, ", ".join(OUTPUTS)))
         if not names:
             raise ValueError("output names nothing to return")
-        if position_reading not in ("replace", "add"):
-            raise ValueError("position_reading must be 'replace' or 'add', got %r" % (position_reading,))
+        if position_channels not in ("replace", "add"):
+            raise ValueError("position_channels must be 'replace' or 'add', got %r" % (position_channels,))
         self.fps, self.window, self.stride = fps, window, stride
         self._names, self._single = names, isinstance(output, str)
-        self._reading = position_reading
+        self._reading = position_channels
         with ThreadPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
             self.clips = list(pool.map(_load, self.paths))
         counts = [self._windows_in(clip, path) for clip, path in zip(self.clips, self.paths)]
@@ -145,9 +145,9 @@ class Dataset:
             if name == "channels":
                 out[name] = clip.sample_frames(at)
             elif name == "world_positions":
-                out[name] = clip.world_positions(frames=at, position_reading=self._reading)
+                out[name] = clip.world_positions(frames=at, position_channels=self._reading)
             elif name not in out:
-                q, t = clip.local_transforms(frames=at, position_reading=self._reading)
+                q, t = clip.local_transforms(frames=at, position_channels=self._reading)
                 out["local_quaternions"], out["local_translations"] = q, t
         arrays = tuple(out[name] for name in self._names)
         return arrays[0] if self._single else arrays

@@ -50,12 +50,6 @@ std::shared_ptr<PyClip> load(const py::object& source) {
   return c;
 }
 
-PositionReading reading_arg(const std::string& r) {
-  if (r == "replace") return PositionReading::replace;
-  if (r == "add") return PositionReading::add;
-  throw py::value_error("position_reading must be 'replace' (Blender's reading, the default) or 'add' (three.js), got '" + r + "'");
-}
-
 // Frame positions from times (seconds) or frames: exactly one of them.
 Positions where(const PyClip& c, const py::handle& times, const py::handle& frames) {
   if (times.is_none() == frames.is_none()) throw py::type_error("give either times or frames (keyword), not both or neither");
@@ -177,21 +171,23 @@ void register_clip(py::module_& m) {
         return py::make_tuple(q, t);
       },
       py::arg("times") = py::none(), py::kw_only(), py::arg("frames") = py::none(),
-      py::arg("position_reading") = "replace",
+      py::arg("position_channels") = "replace",
       "Each node's local transform at each time (or frame position, with frames=): a tuple of\n"
       "quaternions, float32 times.shape + (nodes, 4) as (x, y, z, w), and translations,\n"
-      "times.shape + (nodes, 3). Quaternions are continuous in time. position_reading: how\n"
-      "position channels combine with OFFSET, 'replace' (Blender, keyanim's forward kinematics)\n"
-      "or 'add' (three.js).");
+      "times.shape + (nodes, 3). Quaternions are continuous in time. position_channels: how\n"
+      "position channels below the root combine with OFFSET, as `keyanim sample --world\n"
+      "--position-channels`: 'replace' (the default: Blender, BVH's usual reading) or 'add'\n"
+      "(three.js).");
   cls.def(
       "world_positions",
       [](const PyClip& c, const py::object& times, const py::object& frames, const std::string& reading) {
         return transforms(c, where(c, times, frames), true, reading_arg(reading), false).second;
       },
       py::arg("times") = py::none(), py::kw_only(), py::arg("frames") = py::none(),
-      py::arg("position_reading") = "replace",
+      py::arg("position_channels") = "replace",
       "World (model-space) position of every node at each time (or frame position, with\n"
-      "frames=): float32 array times.shape + (nodes, 3).");
+      "frames=): float32 array times.shape + (nodes, 3). position_channels: 'replace' (the\n"
+      "default) or 'add', as local_transforms.");
   cls.def(
       "channel",
       [](const PyClip& c, int64_t channel) {

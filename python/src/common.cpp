@@ -1,6 +1,8 @@
 #include <cmath>
 
 #include "common.h"
+#include "keyanim/offline/error.h"
+#include "keyanim/offline/settings_text.h"
 
 namespace keyanim::python {
 
@@ -80,6 +82,31 @@ FrameList frames_arg(const py::handle& frames, uint32_t frame_count) {
     out.push_back(uint32_t(f));
   }
   return list;
+}
+
+void set_shell(const py::handle& shell, offline::EncodeSettings& s) {
+  if (py::isinstance<py::str>(shell)) {
+    try {
+      offline::parse_shell(shell.cast<std::string>(), s);
+    } catch (const offline::Error& e) {
+      throw offline::Error(offline::ErrorKind::invalid_argument, "shell: " + e.message());
+    }
+    return;
+  }
+  if (py::isinstance<py::bool_>(shell) || !(py::isinstance<py::float_>(shell) || py::isinstance<py::int_>(shell)))
+    throw py::type_error("shell must be a str such as '2%' (percent of the skeleton size) or a number (units)");
+  s.shell = shell.cast<double>();
+  s.shell_in_percent = false;
+  if (!(s.shell >= 0.0) || !std::isfinite(s.shell))
+    throw offline::Error(offline::ErrorKind::invalid_argument,
+                         "the shell distance must be a number, 0 or more, got " + std::string(py::repr(shell)));
+}
+
+PositionReading reading_arg(const std::string& reading) {
+  if (reading == "replace") return PositionReading::replace;
+  if (reading == "add") return PositionReading::add;
+  throw py::value_error("position_channels must be 'replace' (Blender's reading, the default) or 'add' (three.js), got '" +
+                        reading + "'");
 }
 
 }  // namespace keyanim::python

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/motion.h"
 
 namespace keyanim::python {
@@ -49,6 +50,14 @@ struct Positions {
 Positions positions_arg(const py::handle& array, const char* what);
 // Shape `lead` followed by `tail`.
 std::vector<py::ssize_t> shape_with(std::vector<py::ssize_t> lead, std::initializer_list<py::ssize_t> tail);
+
+// shell= of encode and measure_error, as --shell D|D%: a str ("2%", "3", "0") by the library's
+// grammar, or a number of units -> settings.shell and shell_in_percent. keyanim.Error if
+// negative or not finite, TypeError for another type.
+void set_shell(const py::handle& shell, offline::EncodeSettings& settings);
+
+// 'replace' or 'add' (position_channels=, as --position-channels), else ValueError.
+PositionReading reading_arg(const std::string& reading);
 
 // Frame indices for Motion methods: None -> every frame; else integers in [0, frame_count)
 // (negative ones count from the end, as in numpy), IndexError otherwise; the shape is kept.

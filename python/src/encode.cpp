@@ -56,7 +56,9 @@ void set_keys(const py::handle& keys, offline::EncodeSettings& s) {
 void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);
-    if (name == "tension") {
+    if (name == "shell") {
+      set_shell(value, s);
+    } else if (name == "tension") {
       if (py::isinstance<py::str>(value) && value.cast<std::string>() == "fit") s.fit_tension = true;
       else if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) s.tension = value.cast<float>();
       else throw py::type_error("tension must be a number in [-1, 1] or 'fit'");
@@ -77,7 +79,7 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
       s.force_linear = value.cast<bool>();
     } else {
       throw py::type_error("encode() got an unexpected keyword argument '" + name +
-                           "' (settings: tension, level, threads, tangent_rule, allow_linear, force_linear)");
+                           "' (settings: shell, tension, level, threads, tangent_rule, allow_linear, force_linear)");
     }
   }
   s.validate();
@@ -113,17 +115,23 @@ void register_encode(py::module_& m) {
   m.def("encode", &encode, py::arg("motion"), py::arg("error") = "0.05%", py::arg("keys") = "error",
         "encode(motion, error='0.05%', keys='error', **settings) -> (bytes, report)\n\n"
         "Encodes a Motion into a .kanim file's bytes, as `keyanim encode` does, and returns them\n"
-        "with a report dict holding the same keys as `keyanim encode --json` (frames, channels,\n"
-        "keys, kanim_bytes, ratio_raw_f32, error: {max, rms, worst_joint, worst_frame, ...},\n"
-        "tolerance in file units, encode_ms; input is the motion's file, output None).\n\n"
-        "error: the largest world-space distance any joint or End Site may move, '0.05%' of the\n"
-        "  skeleton size (a str ending in %) or a number in the file's length units.\n"
+        "with a report dict holding the same keys as `keyanim encode --json`: frames, channels,\n"
+        "frame_time, keys, bvh_bytes, raw_f32_bytes, kanim_bytes, ratio_raw_f32, encode_ms,\n"
+        "error: {max, rms, worst_joint, worst_point, worst_shell_axis, worst_frame, shell,\n"
+        "readings, and worst_reading and max_by_reading when both readings of position channels\n"
+        "were measured}, and tolerance in file units; input is the motion's file, output None.\n\n"
+        "error: the largest world-space distance any joint, End Site or shell point may move,\n"
+        "  '0.05%' of the skeleton size (a str ending in %) or a number in the file's length units.\n"
         "keys: 'error' (the fewest keys within error), 'uniform:N', 'manual:F1,F2,...' or a list of\n"
         "  frames, 'curvature'. Modes other than 'error' report error_limit and error_limit_met\n"
         "  instead of tolerance.\n"
-        "settings: tension (in [-1, 1], default 0, or 'fit'), level (zstd, 1..22, default 19),\n"
-        "  threads (default 0: one per core; the bytes do not depend on it), tangent_rule\n"
-        "  ('step_adjusted' or 'uniform'), allow_linear (default True), force_linear (False).\n\n"
+        "settings: shell (as --shell: three points per joint at that distance along its local axes,\n"
+        "  '2%' of the skeleton size by default, a str ending in % or a number of units; 0: joints\n"
+        "  and End Sites only), tension (in [-1, 1], default 0, or 'fit'), level (zstd, 1..22,\n"
+        "  default 19), threads (default 0: one per core; the bytes do not depend on it),\n"
+        "  tangent_rule ('step_adjusted' or 'uniform'), allow_linear (default True), force_linear\n"
+        "  (False). A motion with position channels below the root is kept within error under both\n"
+        "  readings of them (replace and add).\n\n"
         "Releases the GIL while encoding. Raises keyanim.Error for settings that make no sense or a\n"
         "motion the codec cannot store.");
 }

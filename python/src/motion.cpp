@@ -10,6 +10,7 @@
 
 #include "common.h"
 #include "keyanim/offline/bvh.h"
+#include "keyanim/offline/encode.h"
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
@@ -79,6 +80,13 @@ py::array_t<double> per_node(const PyMotion& m, const py::handle& frames_arg_, s
   return out;
 }
 
+// measure_error's shell= in units: as encode's (set_shell), a percentage of the original's size.
+double shell_arg(const py::object& shell, const offline::Motion& original) {
+  offline::EncodeSettings s;
+  set_shell(shell, s);
+  return s.shell_in_percent ? s.shell / 100.0 * offline::reference_size(original) : s.shell;
+}
+
 const char* const kMotionDoc =
     "A motion read from BVH (keyanim.read_bvh) or decoded from a clip (Clip.to_motion): a\n"
     "skeleton and a frames x channels matrix of values, exactly as the file holds them.\n"
@@ -131,17 +139,21 @@ void register_motion(py::module_& m) {
       "with overwrite=True (else FileExistsError).");
   cls.def(
       "world_positions",
-      [](const PyMotion& self, const py::object& frames) {
+      [](const PyMotion& self, const py::object& frames, const std::string& position_channels) {
+        const PositionReading reading = reading_arg(position_channels);
         return per_node(self, frames, 3, [&](const double* row, double* out) {
           thread_local std::vector<offline::Vec3> pos;
-          offline::world_positions(self.motion.skeleton, row, pos);
+          offline::world_positions(self.motion.skeleton, row, pos, reading);
           for (size_t j = 0; j < pos.size(); ++j) std::copy(pos[j].begin(), pos[j].end(), out + 3 * j);
         });
       },
-      py::arg("frames") = py::none(),
+      py::arg("frames") = py::none(), py::kw_only(), py::arg("position_channels") = "replace",
       "World position of every node by forward kinematics (the ground truth keyanim measures\n"
       "errors with): float64 array frames.shape + (nodes, 3). frames: None (every frame), an int\n"
-      "or an array of ints (negative ones count from the end).");
+      "or an array of ints (negative ones count from the end). position_channels: how position\n"
+      "channels below the root combine with OFFSET, as `keyanim sample --world\n"
+      "--position-channels`: 'replace' (the default: Blender, BVH's usual reading) or 'add'\n"
+      "(three.js).");
   cls.def(
       "local_quaternions",
       [](const PyMotion& self, const py::object& frames) {
@@ -168,18 +180,23 @@ void register_motion(py::module_& m) {
         "Releases the GIL while reading.");
   m.def(
       "measure_error",
-      [](const PyMotion& original, const PyMotion& decoded) {
+      [](const PyMotion& original, const PyMotion& decoded, const py::object& shell) {
+        const double distance = shell_arg(shell, original.motion);
         offline::ErrorReport report;
         {
           py::gil_scoped_release unlocked;
-          report = offline::measure_error(original.motion, decoded.motion);
+          report = offline::measure_error(original.motion, decoded.motion, distance);
         }
         return to_python(cli::error_json(original.motion.skeleton, report));
       },
-      py::arg("original"), py::arg("decoded"),
+      py::arg("original"), py::arg("decoded"), py::kw_only(), py::arg("shell") = "2%",
       "World-space distance between two motions of the same skeleton and frame count, over every\n"
-      "joint and End Site and frame: a dict like the 'error' of the encode report (max, rms,\n"
-      "worst_joint, worst_frame, max_leaf_rotation_deg).");
+      "joint, End Site and shell point (shell: as encode's, '2%' of the original's skeleton size\n"
+      "by default, or a number of units; 0: joints and End Sites only) and frame, under both\n"
+      "readings of position channels below the root when it has some: a dict like the 'error'\n"
+      "of the encode report and of `keyanim verify --json` (max, rms, worst_joint, worst_point,\n"
+      "worst_shell_axis, worst_frame, shell, readings; worst_reading and max_by_reading when both\n"
+      "readings were measured). Raises keyanim.Error for motions that differ in layout.");
 }
 
 }  // namespace keyanim::python

@@ -126,7 +126,7 @@ def test_local_transforms_match_independent_rotations(walk, walk_bvh, walk_clip)
     # By time, the same; and 'add' adds the OFFSET to the root's position channels.
     q2, t2 = walk_clip.local_transforms(frames * walk_clip.frame_time)
     np.testing.assert_allclose(q2, q, atol=1e-6)
-    _, added = walk_clip.local_transforms(frames=frames.astype(np.float64), position_reading="add")
+    _, added = walk_clip.local_transforms(frames=frames.astype(np.float64), position_channels="add")
     np.testing.assert_allclose(added[:, 0], t[:, 0] + walk.offsets[0], atol=1e-5)
     # Quaternions are continuous from frame to frame (no sign flips).
     qs = walk_clip.local_transforms(frames=np.arange(344.0))[0]
@@ -195,8 +195,8 @@ def test_argument_errors(keyanim, walk_clip):
         walk_clip.local_transforms([0.0], frames=[0.0])
     with pytest.raises(TypeError):
         walk_clip.world_positions()
-    with pytest.raises(ValueError, match="position_reading"):
-        walk_clip.local_transforms([0.0], position_reading="sideways")
+    with pytest.raises(ValueError, match="position_channels"):
+        walk_clip.local_transforms([0.0], position_channels="sideways")
     with pytest.raises(IndexError):
         walk_clip.channel_keys(96)
     with pytest.raises(IndexError):

@@ -76,8 +76,8 @@ def test_outputs(keyanim, library):
     assert np.array_equal(q, q2) and np.array_equal(t, t2)
     assert np.array_equal(w, clip.world_positions(frames=frames))
     assert q.shape == (10, 38, 4) and w.shape == (10, 38, 3)
-    one = keyanim.Dataset(library, window=10, output="world_positions", position_reading="add")
-    assert np.array_equal(one[3], clip.world_positions(frames=frames, position_reading="add"))
+    one = keyanim.Dataset(library, window=10, output="world_positions", position_channels="add")
+    assert np.array_equal(one[3], clip.world_positions(frames=frames, position_channels="add"))
 
 
 def test_pickles_for_worker_processes(keyanim, library):
@@ -100,7 +100,7 @@ def test_clips_shorter_than_a_window(keyanim, library):
 def test_bad_arguments(keyanim, library, tmp_path):
     for kwargs in (dict(window=0), dict(window=2.5), dict(stride=0), dict(fps=0), dict(fps=-30),
                    dict(fps=float("nan")), dict(output="velocities"), dict(output=()),
-                   dict(position_reading="x")):
+                   dict(position_channels="x")):
         with pytest.raises(ValueError):
             keyanim.Dataset(library, **kwargs)
     with pytest.raises(ValueError, match="no .kanim or .bvh"):
