@@ -143,17 +143,20 @@ def local_rotations(bvh, values):
     return rot
 
 
-def local_translations(bvh, values):
+def local_translations(bvh, values, reading="replace"):
+    """Position channels replace the OFFSET component ("replace", Blender) or add to it ("add",
+    three.js)."""
     t = np.tile(bvh.offsets, (values.shape[0], 1, 1))
     for col, (node, name) in enumerate(bvh.channels):
         if name.lower().endswith("position"):
-            t[:, node, "xyz".index(name[0].lower())] = values[:, col]
+            axis = "xyz".index(name[0].lower())
+            t[:, node, axis] = values[:, col] + (t[:, node, axis] if reading == "add" else 0.0)
     return t
 
 
-def world_positions(bvh, values):
-    """(frames, nodes, 3)."""
-    rot, t = local_rotations(bvh, values), local_translations(bvh, values)
+def world_pose(bvh, values, reading="replace"):
+    """World rotations (frames, nodes, 3, 3) and positions (frames, nodes, 3)."""
+    rot, t = local_rotations(bvh, values), local_translations(bvh, values, reading)
     world_r, world_p = np.empty_like(rot), np.empty_like(t)
     for j, p in enumerate(bvh.parents):
         if p < 0:
@@ -161,7 +164,37 @@ def world_positions(bvh, values):
         else:
             world_r[:, j] = world_r[:, p] @ rot[:, j]
             world_p[:, j] = world_p[:, p] + np.einsum("fij,fj->fi", world_r[:, p], t[:, j])
-    return world_p
+    return world_r, world_p
+
+
+def world_positions(bvh, values, reading="replace"):
+    """(frames, nodes, 3)."""
+    return world_pose(bvh, values, reading)[1]
+
+
+def measured_points(bvh, values, shell, reading="replace"):
+    """The points keyanim's error is measured on: every node (joints and End Sites), then for
+    each joint three shell points at distance `shell` along its local x, y and z axes (the
+    columns of its world rotation): (frames, points, 3)."""
+    world_r, world_p = world_pose(bvh, values, reading)
+    if shell == 0:
+        return world_p
+    joints = [j for j, end in enumerate(bvh.end_site) if not end]
+    shells = world_p[:, joints, None, :] + shell * np.swapaxes(world_r[:, joints], -1, -2)
+    return np.concatenate([world_p, shells.reshape(values.shape[0], -1, 3)], axis=1)
+
+
+def has_positions_below_root(bvh):
+    return any(bvh.parents[node] >= 0 and name.lower().endswith("position") for node, name in bvh.channels)
+
+
+def independent_error(bvh, decoded, shell):
+    """Largest distance of any measured point over every frame between the BVH text's values and
+    `decoded` (frames, channels), under both readings of position channels below the root when
+    there are some (as keyanim measures)."""
+    readings = ("replace", "add") if has_positions_below_root(bvh) else ("replace",)
+    return max(np.linalg.norm(measured_points(bvh, bvh.values, shell, r) - measured_points(bvh, decoded, shell, r),
+                              axis=-1).max() for r in readings)
 
 
 def quaternion_matrices(q):

@@ -6,14 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import HOP, WALK, cli, cli_json, corpus_files, parse_bvh, skeleton_size, world_positions
-
-
-def independent_error(bvh, clip):
-    """Largest distance of any node over the source frames, between the BVH text's FK and the
-    FK of the clip's decoded channel values (both in numpy)."""
-    decoded = clip.sample_frames(np.arange(clip.frame_count)).astype(np.float64)
-    return np.linalg.norm(world_positions(bvh, bvh.values) - world_positions(bvh, decoded), axis=-1).max()
+from conftest import HOP, WALK, cli, cli_json, corpus_files, independent_error, parse_bvh, skeleton_size
 
 
 def test_encode_matches_the_tool(keyanim, walk, walk_encoded, tmp_path):
@@ -32,10 +25,36 @@ def test_encode_matches_the_tool(keyanim, walk, walk_encoded, tmp_path):
 
 def test_encode_meets_its_tolerance(keyanim, walk_bvh, walk_encoded, walk_clip):
     data, report = walk_encoded
-    assert report["tolerance"] == pytest.approx(0.0005 * skeleton_size(walk_bvh), rel=1e-12)
-    err = independent_error(walk_bvh, walk_clip)
-    assert err <= report["tolerance"]
-    assert err == pytest.approx(report["error"]["max"], rel=1e-6)
+    size = skeleton_size(walk_bvh)
+    assert report["tolerance"] == pytest.approx(0.0005 * size, rel=1e-12)
+    assert report["error"]["shell"] == pytest.approx(0.02 * size, rel=1e-12)  # --shell's default
+    assert report["error"]["readings"] == ["replace"]  # no position channels below the root
+    # Every joint, End Site and shell point of the decoded frames, by numpy's own FK.
+    err = independent_error(walk_bvh, walk_clip.to_motion().channels, report["error"]["shell"])
+    assert err <= report["tolerance"] * (1 + 1e-9)
+    assert err == pytest.approx(report["error"]["max"], rel=1e-9)
+    assert independent_error(walk_bvh, walk_clip.to_motion().channels, 0.0) <= err
+
+
+def test_encode_shell_as_the_tool(keyanim, walk, walk_bvh, tmp_path):
+    """shell= takes --shell's grammar (D%, D units, 0) and gives the tool's bytes and report."""
+    size = skeleton_size(walk_bvh)
+    for shell, option, units in (("0", "0", 0.0), ("0%", "0", 0.0), (3.0, "3", 3.0), (0, "0", 0.0),
+                                 ("5%", "5%", 0.05 * size)):
+        data, report = keyanim.encode(walk, shell=shell)
+        out = tmp_path / "s.kanim"
+        tool = cli_json("encode", WALK, "-o", out, "-f", "--shell", option, "--json")
+        assert out.read_bytes() == data, shell
+        assert set(report) == set(tool) and report["error"] == tool["error"], shell
+        assert report["error"]["shell"] == pytest.approx(units, rel=1e-12)
+        if units == 0.0:
+            assert report["error"]["worst_shell_axis"] is None
+        err = independent_error(walk_bvh, keyanim.Clip(data).to_motion().channels, units)
+        assert err <= report["tolerance"] * (1 + 1e-9)
+        assert err == pytest.approx(report["error"]["max"], rel=1e-9)
+    # A shell point is measured: the worst point may be one (then its axis is named).
+    e = keyanim.encode(walk, shell="5%")[1]["error"]
+    assert e["worst_point"] == e["worst_joint"] + ("" if e["worst_shell_axis"] is None else " shell " + e["worst_shell_axis"])
 
 
 def test_encode_error_in_units_and_percent(keyanim, walk):
@@ -80,6 +99,9 @@ def test_other_settings(keyanim, walk):
     (dict(keys=[]), "invalid_argument"), (dict(keys=[-1]), "invalid_argument"),
     (dict(tension=2.0), "invalid_argument"), (dict(level=0), "invalid_argument"),
     (dict(threads=-1), "invalid_argument"), (dict(tangent_rule="x"), "invalid_argument"),
+    (dict(shell="-1"), "invalid_argument"), (dict(shell="abc"), "invalid_argument"),
+    (dict(shell="200%"), "invalid_argument"), (dict(shell=-0.5), "invalid_argument"),
+    (dict(shell=float("inf")), "invalid_argument"), (dict(shell=""), "invalid_argument"),
 ])
 def test_bad_settings(keyanim, walk, kwargs, kind):
     with pytest.raises(keyanim.Error) as info:
@@ -88,7 +110,8 @@ def test_bad_settings(keyanim, walk, kwargs, kind):
 
 
 def test_bad_setting_types(keyanim, walk):
-    for kwargs in (dict(error=None), dict(error=True), dict(keys=3.5), dict(tension="tight"), dict(bogus=1)):
+    for kwargs in (dict(error=None), dict(error=True), dict(keys=3.5), dict(tension="tight"), dict(bogus=1),
+                   dict(shell=None), dict(shell=True), dict(shell=[2])):
         with pytest.raises(TypeError):
             keyanim.encode(walk, **kwargs)
     with pytest.raises(TypeError):
@@ -127,7 +150,8 @@ def test_corpus_encode_within_tolerance(keyanim, path):
     clip = keyanim.Clip(data)
     bvh = parse_bvh(path)
     bvh.values = m.channels  # every line, as read (a few files have more than Frames: says)
-    err = independent_error(bvh, clip)
+    err = independent_error(bvh, clip.to_motion().channels, report["error"]["shell"])
     assert err <= report["tolerance"] * (1 + 1e-9)
+    assert err == pytest.approx(report["error"]["max"], rel=1e-9)
     assert report["kanim_bytes"] == len(data) and report["frames"] == m.frame_count
     assert keyanim.measure_error(m, clip.to_motion()) == report["error"]

@@ -7,7 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, HOP, WALK, cli, corpus_files, local_rotations, parse_bvh, quaternion_matrices, world_positions
+from conftest import (FIXTURES, HOP, WALK, cli, corpus_files, independent_error, local_rotations, parse_bvh,
+                      quaternion_matrices, skeleton_size, world_positions)
 
 
 def check_against_text(m, bvh):
@@ -144,14 +145,101 @@ def test_local_quaternions_match_independent_rotations(walk, walk_bvh):
         walk.local_quaternions("all")
 
 
-def test_measure_error(keyanim, walk, walk_encoded, walk_clip):
+def test_measure_error(keyanim, walk, walk_bvh, walk_encoded, walk_clip):
     zero = keyanim.measure_error(walk, walk)
     assert zero["max"] == 0.0 and zero["rms"] == 0.0
-    e = keyanim.measure_error(walk, walk_clip.to_motion())
+    decoded = walk_clip.to_motion()
+    e = keyanim.measure_error(walk, decoded)
     assert e == walk_encoded[1]["error"]
+    size = skeleton_size(walk_bvh)
+    assert e["shell"] == pytest.approx(0.02 * size, rel=1e-12) and e["readings"] == ["replace"]
+    assert e["max"] == pytest.approx(independent_error(walk_bvh, decoded.channels, e["shell"]), rel=1e-9)
+    # shell= as encode's: percent of the original's size, units, or 0 (joints and End Sites).
+    assert keyanim.measure_error(walk, decoded, shell="2%") == e
+    units = keyanim.measure_error(walk, decoded, shell=4.0)
+    assert units["shell"] == 4.0
+    assert units["max"] == pytest.approx(independent_error(walk_bvh, decoded.channels, 4.0), rel=1e-9)
+    bare = keyanim.measure_error(walk, decoded, shell="0")
+    assert bare["shell"] == 0.0 and bare["worst_shell_axis"] is None and bare["worst_point"] == bare["worst_joint"]
+    assert bare["max"] == pytest.approx(independent_error(walk_bvh, decoded.channels, 0.0), rel=1e-9)
+    assert bare["max"] <= e["max"]
     with pytest.raises(keyanim.Error) as info:
         keyanim.measure_error(walk, keyanim.read_bvh(HOP))
     assert info.value.kind == "invalid_argument"
+    for shell in ("-1", "x", -1.0, float("nan")):
+        with pytest.raises(keyanim.Error):
+            keyanim.measure_error(walk, walk, shell=shell)
+    with pytest.raises(TypeError):
+        keyanim.measure_error(walk, walk, shell=None)
+
+
+# A skeleton with position channels below the root, where BVH readers disagree: Blender replaces
+# the OFFSET component with the channel's value, three.js adds it.
+ARM = """HIERARCHY
+ROOT Hips
+{
+  OFFSET 1 2 3
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Arm
+  {
+    OFFSET 0 10 0
+    CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+    End Site
+    {
+      OFFSET 0 5 0
+    }
+  }
+}
+MOTION
+Frames: 4
+Frame Time: 0.04
+0 0 0 0 0 0 0 10 0 0 0 0
+1 2 3 10 20 30 1 9 2 -40 15 5
+-1 0.5 2 -30 5 60 0.5 11 -1 70 -20 10
+2 1 0 45 -45 90 -2 8 3 5 90 -80
+"""
+
+
+@pytest.fixture
+def arm(tmp_path):
+    path = tmp_path / "arm.bvh"
+    path.write_text(ARM)
+    return path
+
+
+def test_world_positions_position_channels(keyanim, arm):
+    m, bvh = keyanim.read_bvh(arm), parse_bvh(arm)
+    replace = m.world_positions()
+    assert np.array_equal(replace, m.world_positions(position_channels="replace"))
+    np.testing.assert_allclose(replace, world_positions(bvh, bvh.values, "replace"), rtol=0, atol=1e-12)
+    add = m.world_positions(position_channels="add")
+    np.testing.assert_allclose(add, world_positions(bvh, bvh.values, "add"), rtol=0, atol=1e-12)
+    assert not np.allclose(add, replace)
+    assert np.array_equal(m.world_positions([2], position_channels="add"), add[[2]])
+    with pytest.raises(ValueError, match="position_channels"):
+        m.world_positions(position_channels="sideways")
+
+
+def test_measure_error_under_both_readings(keyanim, arm):
+    """Position channels below the root: measured under both readings, as verify reports."""
+    m, bvh = keyanim.read_bvh(arm), parse_bvh(arm)
+    moved = keyanim.read_bvh(arm)
+    moved.channels[1, 7] += 0.25  # the Arm's Yposition at frame 1
+    moved.channels[2, 10] += 3.0  # the Arm's Xrotation at frame 2
+    e = keyanim.measure_error(m, moved, shell=1.0)
+    assert e["readings"] == ["replace", "add"] and e["worst_reading"] in ("replace", "add")
+    for reading in ("replace", "add"):
+        got = np.linalg.norm(world_positions(bvh, bvh.values, reading) - world_positions(bvh, moved.channels, reading),
+                             axis=-1).max()
+        assert e["max_by_reading"][reading] >= got - 1e-12
+    assert e["max"] == max(e["max_by_reading"].values())
+    assert e["max"] == pytest.approx(independent_error(bvh, moved.channels, 1.0), rel=1e-12)
+    # The encoder measures its clip the same way.
+    data, report = keyanim.encode(m, error=0.01, shell=1.0)
+    assert report["error"]["readings"] == ["replace", "add"]
+    clip = keyanim.Clip(data)
+    assert keyanim.measure_error(m, clip.to_motion(), shell=1.0) == report["error"]
+    assert independent_error(bvh, clip.to_motion().channels, 1.0) <= 0.01 * (1 + 1e-9)
 
 
 @pytest.mark.corpus
