@@ -10,7 +10,7 @@
 #  3. every session of the README (blocks of "$ " lines) pasted line by line, printing what the
 #     README shows (tests/newcomer/readme_session.py);
 #  4. every command's --help read for options described twice and incomplete usage lines
-#     (tests/cli/help_test.py); `man keyanim` and the bash completion found;
+#     (tests/cli/help_test.py); `man keyanim`, the bash completion and `import keyanim` found;
 #  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
 #     as skipped with their reason, and no test may pass without checking anything
 #     (tests/ctest_report.py).
@@ -46,11 +46,17 @@ export PATH="$KEYANIM_PREFIX/bin:$PATH"
 step "3. the README's sessions, pasted line by line"
 "$PY" tests/newcomer/readme_session.py README.md
 
-step "4. every command's help; man keyanim; bash completion"
+step "4. every command's help; man keyanim; bash completion; import keyanim"
 "$PY" tests/cli/help_test.py "$(command -v keyanim)"
 man -w keyanim | grep -q "^$KEYANIM_PREFIX/" || { echo "newcomer: FAIL: man keyanim does not find the installed page"; exit 1; }
 [ -f "$KEYANIM_PREFIX/share/bash-completion/completions/keyanim" ] || { echo "newcomer: FAIL: no bash completion installed"; exit 1; }
 echo "man page and completion installed"
+# The Python module: in the prefix's site-packages, which the install named (a scratch prefix is
+# not on Python's path; ~/.local and /usr/local are: python/tests/install_test.sh).
+site=$(ls -d "$KEYANIM_PREFIX"/lib/python3*/site-packages 2>/dev/null | head -n1)
+[ -f "$site/keyanim/__init__.py" ] || { echo "newcomer: FAIL: no Python module installed in $KEYANIM_PREFIX"; exit 1; }
+PYTHONPATH=$site /usr/bin/python3 -c 'import keyanim, sys; assert keyanim.__file__.startswith(sys.argv[1]); print("Python module", keyanim.__version__, "installed")' "$site" ||
+  { echo "newcomer: FAIL: /usr/bin/python3 cannot import the installed keyanim"; exit 1; }
 
 step "5. the README's test command, without the sanitizer stage"
 tests=$(block "Running the tests" "scripts/test.sh")
