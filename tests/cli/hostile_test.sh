@@ -323,7 +323,8 @@ exit_table)
   sed -n '/^exit codes:/,/^  7 /p' "$README" >readme.txt
   diff help.txt readme.txt >/dev/null || die "the README's exit code table differs from --help: $(diff help.txt readme.txt)"
   for c in encode decode info sample plot render eval verify; do
-    "$K" "$c" --help | grep -qF "$(sed -n 2p help.txt)" || die "$c --help lacks the exit code table"
+    # (grep reads it all: -q would close the pipe early, so that keyanim died of SIGPIPE under pipefail)
+    "$K" "$c" --help | grep -F "$(sed -n 2p help.txt)" >/dev/null || die "$c --help lacks the exit code table"
   done
   # Every row.
   "$K" -q encode "$WALK" -o w.kanim || die "encode"
