@@ -127,12 +127,16 @@ TEST_SUITE("budget") {
     CHECK(b.min_tolerance(9) == 0.3);
   }
 
-  TEST_CASE("the step halves until it is within the fraction of the smallest tolerance") {
+  TEST_CASE("the step shrinks by quarter octaves until it is within the fraction of the smallest tolerance") {
     const Motion m = tree(3);
     Budgets b(m.skeleton, std::vector<double>(12, 1.0), 3);
     CHECK(b.step(0, 1.5) == 1.5);
-    b.tighten(1, {{0, 0.3}});  // smallest tolerance of Hips' channels 0.3: 1.5 -> 0.75 -> 0.375
-    CHECK(b.step(0, 1.5) == 0.375);
+    // Smallest tolerance of Hips' channels 0.3, limit 0.45: 1.5 * 2^(-k/4) first at or below
+    // it for k = 7 (k = 6: 0.530).
+    b.tighten(1, {{0, 0.3}});
+    CHECK(b.step(0, 1.5) == doctest::Approx(1.5 * std::exp2(-7.0 / 4.0)));
+    CHECK(b.step(0, 1.5) <= 0.45);
+    CHECK(b.step(0, 1.5) > 0.45 * std::exp2(-1.0 / 4.0));  // the coarsest such step
     CHECK(b.step(9, 1.5) == 1.5);
   }
 }

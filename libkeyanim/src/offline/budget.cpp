@@ -33,6 +33,13 @@ double local_translation_length(const Motion& m, const Joint& j, size_t stride) 
   return best;
 }
 
+// A step falls by a quarter octave at a time: finer than halving, so that a channel keyed at
+// nearly every frame (its bytes are then its values' bits) is not quantized up to twice as
+// finely as its tolerance needs; coarse enough that a few tightened frames rarely requantize
+// it. Measured on the corpus (bench_codec, 41 files, kStepFraction 2.0) against halving: 4.0%
+// fewer bytes at 0.05% of the skeleton size, 1.7% at 0.5% (2^-1/8: 3.9% and 0.3%).
+constexpr double kStepShrink = 0.8408964152537145;  // 2^(-1/4)
+
 // A rotation that moves no measured point (a leaf joint without a shell) has this budget.
 constexpr double kMaxRotationBudget = 180.0;
 
@@ -93,7 +100,7 @@ Tolerance Budgets::tolerance(uint32_t c) const noexcept {
 double Budgets::step(uint32_t c, double fraction) const noexcept {
   double step = fraction * base_[c];
   const double limit = fraction * min_tolerance(c);
-  while (step > limit) step *= 0.5;
+  while (step > limit) step *= kStepShrink;
   return step;
 }
 

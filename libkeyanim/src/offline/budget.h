@@ -47,9 +47,9 @@ class Budgets {
   // The view a fit reads.
   Tolerance tolerance(uint32_t c) const noexcept;
   double min_tolerance(uint32_t c) const noexcept { return base_[c] * double(min_factor_[c]); }
-  // Quantization step: `fraction` of the base, halved until within `fraction` of the smallest
-  // tolerance. Halving rather than following the smallest tolerance: tightening a few frames
-  // then rarely requantizes the whole channel.
+  // Quantization step: `fraction` of the base, shrunk by quarter octaves until within
+  // `fraction` of the smallest tolerance. Steps rather than following the smallest tolerance:
+  // tightening a few frames then rarely requantizes the whole channel.
   double step(uint32_t c, double fraction) const noexcept;
 
   // Tightens, at `frame`, each channel that moves one of `over` by the smallest ratio among
