@@ -127,16 +127,22 @@ TEST_SUITE("budget") {
     CHECK(b.min_tolerance(9) == 0.3);
   }
 
-  TEST_CASE("the step shrinks by quarter octaves until it is within the fraction of the smallest tolerance") {
+  TEST_CASE("the step is the largest power of 2^(1/4) within the fraction of the smallest tolerance, or the one held") {
     const Motion m = tree(3);
     Budgets b(m.skeleton, std::vector<double>(12, 1.0), 3);
-    CHECK(b.step(0, 1.5) == 1.5);
-    // Smallest tolerance of Hips' channels 0.3, limit 0.45: 1.5 * 2^(-k/4) first at or below
-    // it for k = 7 (k = 6: 0.530).
+    // Limit 1.5: 2^(2/4) = 1.414 (2^(3/4) = 1.682 is over it).
+    CHECK(b.step(0, 1.5) == std::sqrt(2.0));
+    CHECK(b.step(0, 2.0) == 2.0);  // a power of it: itself
+    // Smallest tolerance of Hips' channels 0.3, limit 0.45: 2^(-5/4) = 0.4204 (2^(-4/4) = 0.5 is over).
     b.tighten(1, {{0, 0.3}});
-    CHECK(b.step(0, 1.5) == doctest::Approx(1.5 * std::exp2(-7.0 / 4.0)));
+    CHECK(b.step(0, 1.5) == doctest::Approx(std::exp2(-5.0 / 4.0)).epsilon(1e-15));
     CHECK(b.step(0, 1.5) <= 0.45);
-    CHECK(b.step(0, 1.5) > 0.45 * std::exp2(-1.0 / 4.0));  // the coarsest such step
-    CHECK(b.step(9, 1.5) == 1.5);
+    CHECK(b.step(9, 1.5) == std::sqrt(2.0));  // untouched
+    // Held while the step would stay above half of it; otherwise the step follows the tolerance.
+    CHECK(b.step(0, 1.5, 0.8) == 0.8);  // 0.4204 > 0.4
+    CHECK(b.step(0, 1.5, 0.84) == 0.84);
+    CHECK(b.step(0, 1.5, 0.85) == doctest::Approx(std::exp2(-5.0 / 4.0)).epsilon(1e-15));  // 0.4204 < 0.425
+    CHECK(b.step(0, 1.5, std::sqrt(2.0)) == doctest::Approx(std::exp2(-5.0 / 4.0)).epsilon(1e-15));
+    CHECK(b.step(0, 1.5, 0.3) == doctest::Approx(std::exp2(-5.0 / 4.0)).epsilon(1e-15));  // never finer than needed
   }
 }

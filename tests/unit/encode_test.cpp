@@ -132,7 +132,10 @@ TEST_SUITE("encode") {
     CHECK(r.clip.channels[5].frames.size() <= 4);
     CHECK(back.value(599, 5) > 180.0);
     const ErrorReport e = measure_error(m, back);
-    CHECK(e.channel_max[5] < 0.01);
+    // Off by no wrap (360 degrees): within the angle that moves the End Site, 20 units away,
+    // by the tolerance (the channel's first budget; a key may use all of it since steps are
+    // held, budget.h).
+    CHECK(e.channel_max[5] < 0.01 / 20.0 * 180.0 / std::numbers::pi);
   }
 
   TEST_CASE("uniform mode puts keys every N frames on every moving channel") {
