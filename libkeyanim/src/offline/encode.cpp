@@ -35,9 +35,9 @@ namespace {
 // Quantization step as a fraction of the channel's smallest per-frame tolerance (a key is then
 // off by at most that tolerance; Budgets::step). Errors are checked after quantization, so a
 // coarse step costs only a few extra keys. Measured on the corpus (bench_codec, 41 files) with
-// quarter-octave steps, against 1.5: 2.0 takes 1.6% fewer bytes at 0.05% of the skeleton size
-// and 0.2% fewer at 0.5% (1.75: 0.7% and 0.9% fewer; 2.25: 0.4% fewer and 2.5% more; 2.5:
-// 0.1% and 6.4% more).
+// the steps of Budgets::step, held (kStepHoldRounds), against 1.5: 2.0 takes 2.1% fewer bytes
+// at 0.05% of the skeleton size and 0.9% more at 0.5% (1.75: 1.3% fewer, 1.5% more); with
+// quarter octaves and no hold, 2.25 and 2.5 lost at 0.5% (2.5% and 6.4% more than 1.5).
 constexpr double kStepFraction = 2.0;
 // Tightening multiplies a tolerance by the ratio it is over times a margin. A margin near 1
 // wastes no budget but needs more rounds (0.97 throughout fails to converge in 40 rounds on
