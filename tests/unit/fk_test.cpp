@@ -636,7 +636,7 @@ TEST_CASE("metrics modulo 360 channel comparison") {
   CHECK(r.channel_max[0] == 540.0);
 }
 
-TEST_CASE("metrics: mismatched or broken motions are errors; NaN values an infinite error") {
+TEST_CASE("metrics: mismatched or broken motions are errors and NaN values an infinite error") {
   const double inf = std::numeric_limits<double>::infinity();
   const Motion a = metrics_motion();
   auto kind_of = [&](const Motion& b) {
