@@ -58,15 +58,19 @@ struct Image {
   TangentRule rule = TangentRule::step_adjusted;
   Skeleton skeleton;
   std::vector<float> node_offset;  // 3 per node: OFFSET in binary32, for poses
-  // Poses: each node's channels as (column, axis, rotation?) steps, nodes one after the other;
-  // node i's steps are pose_steps[pose_first[i] .. pose_first[i + 1]).
-  struct PoseStep {
+  // Poses: each node's rotation channels (column and axis, in channel order: the order they
+  // compose in) and its position channels, nodes one after the other. Node i's rotations are
+  // rot_column/rot_axis[rot_first[i] .. rot_first[i + 1]), its positions
+  // moves[move_first[i] .. move_first[i + 1]). Rotation columns are contiguous so that a
+  // batch of angles is one gather.
+  struct Move {
     uint32_t column;
-    uint8_t axis;      // 0 X, 1 Y, 2 Z
-    uint8_t rotation;  // 1 rotation, 0 position
+    uint32_t axis;  // 0 X, 1 Y, 2 Z
   };
-  std::vector<PoseStep> pose_steps;
-  std::vector<uint32_t> pose_first;
+  std::vector<uint32_t> rot_column, rot_first;
+  std::vector<uint8_t> rot_axis;  // 0 X, 1 Y, 2 Z
+  std::vector<Move> moves;
+  std::vector<uint32_t> move_first;
   std::string notes;
   uint64_t total_keys = 0;
   uint64_t id = 0;  // distinguishes clips for cursors (an address can be reused)

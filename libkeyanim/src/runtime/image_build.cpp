@@ -107,8 +107,11 @@ void shrink(Image& img) {
   img.skeleton.joints.shrink_to_fit();
   for (Joint& j : img.skeleton.joints) j.name.shrink_to_fit(), j.channels.shrink_to_fit();
   img.node_offset.shrink_to_fit();
-  img.pose_steps.shrink_to_fit();
-  img.pose_first.shrink_to_fit();
+  img.rot_column.shrink_to_fit();
+  img.rot_axis.shrink_to_fit();
+  img.rot_first.shrink_to_fit();
+  img.moves.shrink_to_fit();
+  img.move_first.shrink_to_fit();
   img.fixed_channels.shrink_to_fit();
   img.curves.shrink_to_fit();
   img.list_frames.shrink_to_fit();
@@ -128,8 +131,9 @@ size_t Image::memory_bytes() const noexcept {
     n += j.name.capacity() > 15 ? j.name.capacity() : 0;  // beyond the small-string buffer
     n += j.channels.capacity() * sizeof(ChannelType);
   }
-  n += node_offset.capacity() * sizeof(float) + pose_steps.capacity() * sizeof(PoseStep) +
-       pose_first.capacity() * sizeof(uint32_t);
+  n += node_offset.capacity() * sizeof(float) + rot_column.capacity() * sizeof(uint32_t) +
+       rot_axis.capacity() + rot_first.capacity() * sizeof(uint32_t) + moves.capacity() * sizeof(Move) +
+       move_first.capacity() * sizeof(uint32_t);
   n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
   n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
   n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
@@ -151,12 +155,21 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   img->skeleton = std::move(src.skeleton);
   for (const Joint& j : img->skeleton.joints) {
     for (double o : j.offset) img->node_offset.push_back(static_cast<float>(o));
-    img->pose_first.push_back(static_cast<uint32_t>(img->pose_steps.size()));
-    for (size_t k = 0; k < j.channels.size(); ++k)
-      img->pose_steps.push_back({j.first_channel + static_cast<uint32_t>(k), static_cast<uint8_t>(channel_axis(j.channels[k])),
-                                 static_cast<uint8_t>(is_rotation(j.channels[k]))});
+    img->rot_first.push_back(static_cast<uint32_t>(img->rot_column.size()));
+    img->move_first.push_back(static_cast<uint32_t>(img->moves.size()));
+    for (size_t k = 0; k < j.channels.size(); ++k) {
+      const uint32_t column = j.first_channel + static_cast<uint32_t>(k);
+      const int axis = channel_axis(j.channels[k]);
+      if (is_rotation(j.channels[k])) {
+        img->rot_column.push_back(column);
+        img->rot_axis.push_back(static_cast<uint8_t>(axis));
+      } else {
+        img->moves.push_back({column, static_cast<uint32_t>(axis)});
+      }
+    }
   }
-  img->pose_first.push_back(static_cast<uint32_t>(img->pose_steps.size()));
+  img->rot_first.push_back(static_cast<uint32_t>(img->rot_column.size()));
+  img->move_first.push_back(static_cast<uint32_t>(img->moves.size()));
   img->notes = std::move(src.notes);
   img->total_keys = src.frames.size();
   static std::atomic<uint64_t> next_id{1};

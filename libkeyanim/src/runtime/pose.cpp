@@ -11,14 +11,47 @@
 namespace keyanim::internal {
 namespace {
 
-// q = q * (rotation by the angle whose half has sine s and cosine c about `axis`).
-inline void rotate_by(float* q, int axis, float s, float c) noexcept {
+// q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w).
+// Each component is one product with c plus one signed product with s.
+inline void rotate_by(float* q, uint32_t axis, float s, float c) noexcept {
   const float x = q[0], y = q[1], z = q[2], w = q[3];
   switch (axis) {
     case 0: q[0] = w * s + x * c, q[1] = y * c + z * s, q[2] = z * c - y * s, q[3] = w * c - x * s; break;
     case 1: q[0] = x * c - z * s, q[1] = w * s + y * c, q[2] = z * c + x * s, q[3] = w * c - y * s; break;
     default: q[0] = x * c + y * s, q[1] = y * c - x * s, q[2] = w * s + z * c, q[3] = w * c - z * s; break;
   }
+}
+
+#if KEYANIM_SSE2
+// The same in one register: q c + t s, t a signed permutation of q per axis. The products and
+// sums are those above (a + (-b) is a - b, and addition commutes), so the bits are the same.
+[[gnu::always_inline]] inline __m128 rotate_by(__m128 q, uint32_t axis, float s, float c) noexcept {
+  const __m128 neg23 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, INT32_MIN, 0, 0));
+  const __m128 neg03 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, 0, INT32_MIN));
+  const __m128 neg13 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, INT32_MIN, 0));
+  __m128 t;
+  switch (axis) {
+    case 0: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(0, 1, 2, 3)), neg23); break;   // (w, z, -y, -x)
+    case 1: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(1, 0, 3, 2)), neg03); break;   // (-z, w, x, -y)
+    default: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(2, 3, 0, 1)), neg13); break;  // (y, -x, w, -z)
+  }
+  return _mm_add_ps(_mm_mul_ps(q, _mm_set1_ps(c)), _mm_mul_ps(t, _mm_set1_ps(s)));
+}
+#endif
+
+// Node `node`'s rotation, its angles' half sines and cosines at s[k - base], c[k - base].
+inline void node_rotation(const Image& img, uint32_t node, uint32_t base, const float* s, const float* c,
+                          float* rotation) noexcept {
+  const uint8_t* axis = img.rot_axis.data();
+  const uint32_t begin = img.rot_first[node], end = img.rot_first[node + 1];
+#if KEYANIM_SSE2
+  __m128 q = _mm_set_ps(1.0f, 0.0f, 0.0f, 0.0f);
+  for (uint32_t k = begin; k < end; ++k) q = rotate_by(q, axis[k], s[k - base], c[k - base]);
+  _mm_storeu_ps(rotation, q);
+#else
+  rotation[0] = rotation[1] = rotation[2] = 0.0f, rotation[3] = 1.0f;
+  for (uint32_t k = begin; k < end; ++k) rotate_by(rotation, axis[k], s[k - base], c[k - base]);
+#endif
 }
 
 // v rotated by unit quaternion q: v + 2 w (u x v) + 2 u x (u x v), u = q.xyz.
@@ -40,41 +73,36 @@ inline void multiply(const float* a, const float* b, float* out) noexcept {
   out[0] = x, out[1] = y, out[2] = z, out[3] = w;
 }
 
-constexpr uint32_t kAngles = 64;  // rotation channels converted per batch
+constexpr uint32_t kAngles = 64;  // rotation channels converted per batch (>= 6, a node's most)
 
 }  // namespace
 
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
                       Transform* out) noexcept {
   if (first >= last) return;
-  const Image::PoseStep* steps = img.pose_steps.data();
-  const uint32_t* at = img.pose_first.data();
-  const uint32_t column0 = at[first] < at[last] ? steps[at[first]].column : 0;
-  float angles[kAngles], sines[kAngles], cosines[kAngles];
-  uint32_t node = first;
-  while (node < last) {
-    // Nodes [node, end) whose rotation channels fit one batch (a node has at most 6 channels).
-    uint32_t end = node, count = 0;
-    for (; end < last && count + (at[end + 1] - at[end]) <= kAngles; ++end)
-      for (uint32_t s = at[end]; s < at[end + 1]; ++s)
-        if (steps[s].rotation) angles[count++] = values[steps[s].column - column0];
+  const uint32_t column0 = img.skeleton.joints[first].first_channel;  // values[0]'s column
+  const uint32_t* rot_first = img.rot_first.data();
+  const uint32_t* rot_column = img.rot_column.data();
+  alignas(16) float angles[kAngles], sines[kAngles], cosines[kAngles];
+  for (uint32_t node = first; node < last;) {
+    // Nodes [node, end) whose rotation channels fit one batch: one gather, one conversion.
+    const uint32_t base = rot_first[node];
+    uint32_t end = node + 1;
+    while (end < last && rot_first[end + 1] - base <= kAngles) ++end;
+    const uint32_t count = rot_first[end] - base;
+    for (uint32_t k = 0; k < count; ++k) angles[k] = values[rot_column[base + k] - column0];
     half_sincos_deg(angles, sines, cosines, count);
-    uint32_t a = 0;
     for (; node < end; ++node) {
       Transform& t = out[node - first];
-      t = Transform{};
       const float* offset = img.node_offset.data() + 3 * size_t(node);
-      std::copy(offset, offset + 3, t.translation);
-      for (uint32_t s = at[node]; s < at[node + 1]; ++s) {
-        const Image::PoseStep step = steps[s];
-        if (step.rotation) {
-          rotate_by(t.rotation, step.axis, sines[a], cosines[a]);
-          ++a;
-        } else {
-          const float v = values[step.column - column0];
-          t.translation[step.axis] = reading == PositionReading::add ? offset[step.axis] + v : v;
-        }
+      t.translation[0] = offset[0], t.translation[1] = offset[1], t.translation[2] = offset[2];
+      t.reserved = 0.0f;
+      for (uint32_t m = img.move_first[node]; m < img.move_first[node + 1]; ++m) {
+        const Image::Move move = img.moves[m];
+        const float v = values[move.column - column0];
+        t.translation[move.axis] = reading == PositionReading::add ? offset[move.axis] + v : v;
       }
+      node_rotation(img, node, base, sines, cosines, t.rotation);
     }
   }
 }
