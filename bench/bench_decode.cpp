@@ -99,6 +99,24 @@ void flush_image(const Clip& clip) {
   flush_vec(img.fixed_value);
   flush_vec(img.fixed_channels);
   flush_vec(img.node_offset);
+  flush_vec(img.curve_s);
+  flush_vec(img.first_frame);
+  flush_vec(img.last_frame);
+  flush_vec(img.first_value);
+  flush_vec(img.last_value);
+  flush_vec(img.curve_linear);
+  flush_vec(img.curve_channel);
+  flush_vec(img.list_frames);
+  flush_vec(img.list_values);
+  flush_vec(img.interp);
+  flush_vec(img.tension);
+  flush_vec(img.key_count);
+  flush_vec(img.fixed_frame);
+  flush_vec(img.rot_column);
+  flush_vec(img.rot_axis);
+  flush_vec(img.rot_first);
+  flush_vec(img.moves);
+  flush_vec(img.move_first);
   flush_vec(img.skeleton.joints);
   for (const auto& j : img.skeleton.joints) flush_vec(j.channels);
 }

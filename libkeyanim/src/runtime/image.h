@@ -39,6 +39,7 @@ inline constexpr uint32_t kBlockFrames = 1u << kBlockShift;
 inline constexpr uint32_t kRecordBitsAt = 80;  // Context starts after Mask, Value_Bits, Context_Bits
 inline constexpr uint32_t kContextKeys = 4;
 inline constexpr uint32_t kNoCurve = UINT32_MAX;
+inline constexpr uint32_t kPrefetchRecords = 8;  // see Image::record_offset
 inline constexpr size_t kPayloadPadding = 8;  // so that an 8-byte load at any record bit is in bounds
 
 // Per curve, what reading its records needs (the rest is in Image's per-curve arrays).
@@ -96,8 +97,11 @@ struct Image {
   std::vector<float> first_frame, last_frame;  // K_0 and K_{n-1}
   std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
   std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
+  std::vector<uint32_t> curve_channel;   // curves[i].channel, contiguous: a pose's scatter
   uint32_t block_count = 0;
-  std::vector<uint32_t> record_offset;  // [block * block_curves + curve]: byte offset in payload
+  // [block * block_curves + curve]: byte offset in payload; kPrefetchRecords extra zeros at the
+  // end, so that the sampler may read the offset of a record a few curves ahead unchecked.
+  std::vector<uint32_t> record_offset;
   std::vector<uint8_t> payload;         // records, then kPayloadPadding zero bytes
 
   const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
@@ -122,11 +126,13 @@ inline uint64_t read_bits(const uint8_t* p, uint64_t bit, uint32_t width) noexce
 // One record's window around position t (0 <= t < kBlockFrames: frame block_start + t, or the
 // block's first or last frame for positions outside it): key j is the last key at or before
 // block_start + t (a context key when the block has none up to t), and j-1, j+1, j+2 its
-// neighbours. Frames are relative to the block's start; value[k] + base + q_base is key k's q.
+// neighbours. Frames are relative to the block's start; the four keys' values are the
+// value_bits-wide fields from record bit `at` on (window_values), and value + base + q_base is a
+// key's q.
 struct Window {
   int32_t frame[4];   // k_{j-1}, k_j, k_{j+1}, k_{j+2}
-  uint64_t value[4];
   uint64_t base;
+  uint64_t at;        // record bit of key j-1's value
   uint32_t value_bits;
 };
 
@@ -202,18 +208,23 @@ template <bool kPopcnt>
   const uint64_t base_at = kRecordBitsAt + 4 * uint64_t(kw);
   w.base = read_bits(rec, base_at, base_bits);
   w.value_bits = vw;
-  const uint64_t at = base_at + base_bits + uint64_t(count) * vw;
-  if (vw <= 28) [[likely]] {  // two loads, two values each
+  w.at = base_at + base_bits + uint64_t(count) * vw;
+}
+
+// The window's four values (see Window).
+inline void window_values(const uint8_t* rec, const Window& w, uint64_t* value) noexcept {
+  const uint32_t vw = w.value_bits;
+  if (vw <= 28) {  // two loads, two values each
     const uint64_t m = (uint64_t(1) << vw) - 1;
     uint64_t x, y;
-    std::memcpy(&x, rec + (at >> 3), 8);
-    std::memcpy(&y, rec + ((at + 2 * vw) >> 3), 8);
-    x >>= at & 7;
-    y >>= (at + 2 * vw) & 7;
-    w.value[0] = x & m, w.value[1] = (x >> vw) & m;
-    w.value[2] = y & m, w.value[3] = (y >> vw) & m;
+    std::memcpy(&x, rec + (w.at >> 3), 8);
+    std::memcpy(&y, rec + ((w.at + 2 * vw) >> 3), 8);
+    x >>= w.at & 7;
+    y >>= (w.at + 2 * vw) & 7;
+    value[0] = x & m, value[1] = (x >> vw) & m;
+    value[2] = y & m, value[3] = (y >> vw) & m;
   } else {
-    for (uint32_t k = 0; k < 4; ++k) w.value[k] = read_bits(rec, at + k * vw, vw);
+    for (uint32_t k = 0; k < 4; ++k) value[k] = read_bits(rec, w.at + k * vw, vw);
   }
 }
 

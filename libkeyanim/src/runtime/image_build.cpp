@@ -119,6 +119,7 @@ void shrink(Image& img) {
   for (auto* v : {&img.curve_s, &img.first_frame, &img.last_frame, &img.first_value, &img.last_value})
     v->shrink_to_fit();
   img.curve_linear.shrink_to_fit();
+  img.curve_channel.shrink_to_fit();
   img.notes.shrink_to_fit();
 }
 
@@ -139,7 +140,8 @@ size_t Image::memory_bytes() const noexcept {
   n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
   n += curve_s.capacity() * sizeof(float) + first_frame.capacity() * sizeof(float) +
        last_frame.capacity() * sizeof(float) + first_value.capacity() * sizeof(float) +
-       last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t);
+       last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t) +
+       curve_channel.capacity() * sizeof(uint32_t);
   n += list_frames.capacity() * sizeof(uint32_t) + list_values.capacity() * sizeof(float);
   n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
   return n;
@@ -225,6 +227,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
       img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
       img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
       img->curves.push_back(cv);
+      img->curve_channel.push_back(cv.channel);
     }
     if (pass == 0) img->block_curves = static_cast<uint32_t>(img->curves.size());
   }
@@ -258,7 +261,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   }
   // Offsets in block-major order; u32 offsets bound the payload (checked: 2^32 bytes is far
   // beyond any clip the decoder's limits admit, but a too large one must fail, not wrap).
-  img->record_offset.resize(records);
+  img->record_offset.resize(records + kPrefetchRecords);
   uint64_t total = 0;
   for (size_t r = 0; r < records; ++r) {
     if (total > UINT32_MAX) throw std::bad_alloc();

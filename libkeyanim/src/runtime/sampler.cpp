@@ -17,6 +17,7 @@ namespace {
 
 constexpr uint32_t kChunk = 32;  // a multiple of 4 (SIMD lanes)
 constexpr uint32_t kPrefetchAhead = 6;  // curves
+static_assert(kPrefetchAhead <= kPrefetchRecords, "the offsets ahead are read unchecked");
 
 // Pass one's output for a chunk: per lane its keys j-1 .. j+2 (frames relative to the block,
 // dequantized values), and the per-curve facts the evaluation needs (which the sampler of all
@@ -58,20 +59,42 @@ Position position(const Image& img, float f) noexcept {
 // q = q_base + base + value, dequantized as Appendix A says (binary64 product, one rounding).
 // double(q_base + base) + double(value) is exact (|q| <= 2^53), so two lanes at a time with
 // SSE2 give the very same values.
-[[gnu::always_inline]] inline void dequantize4(const Window& w, const Curve& cv, float* out) noexcept {
-  const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
 #if KEYANIM_SSE2
-  if (w.value_bits <= 31) {
-    const __m128i v = _mm_set_epi32(static_cast<int32_t>(w.value[3]), static_cast<int32_t>(w.value[2]),
-                                    static_cast<int32_t>(w.value[1]), static_cast<int32_t>(w.value[0]));
-    const __m128d lowd = _mm_set1_pd(static_cast<double>(low)), step = _mm_set1_pd(cv.step);
-    const __m128d a = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(v), lowd), step);
-    const __m128d b = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(v, v)), lowd), step);
-    _mm_storeu_ps(out, _mm_movelh_ps(_mm_cvtpd_ps(a), _mm_cvtpd_ps(b)));
+[[gnu::always_inline]] inline void dequantize4(__m128i v, int64_t low, double step, float* out) noexcept {
+  const __m128d lowd = _mm_set1_pd(static_cast<double>(low)), s = _mm_set1_pd(step);
+  const __m128d a = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(v), lowd), s);
+  const __m128d b = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(v, v)), lowd), s);
+  _mm_storeu_ps(out, _mm_movelh_ps(_mm_cvtpd_ps(a), _mm_cvtpd_ps(b)));
+}
+#endif
+
+[[gnu::always_inline]] inline void dequantize4(const uint8_t* rec, const Window& w, const Curve& cv, float* out) noexcept {
+  const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
+  const uint32_t vw = w.value_bits;
+#if KEYANIM_SSE2
+  if (vw <= 14) {  // the usual widths: the four values in one load, split in two 64-bit lanes
+    uint64_t x;
+    std::memcpy(&x, rec + (w.at >> 3), 8);
+    x >>= w.at & 7;  // 4 vw + 7 <= 63 bits
+    const __m128i m = _mm_set1_epi64x(static_cast<int64_t>((uint64_t(1) << vw) - 1));
+    const __m128i v = _mm_set_epi64x(static_cast<int64_t>(x >> (2 * vw)), static_cast<int64_t>(x));  // v0 v1 | v2 v3
+    const __m128i even = _mm_and_si128(v, m);                                        // v0, v2
+    const __m128i odd = _mm_and_si128(_mm_srl_epi64(v, _mm_cvtsi32_si128(static_cast<int>(vw))), m);  // v1, v3
+    dequantize4(_mm_or_si128(even, _mm_slli_epi64(odd, 32)), low, cv.step, out);
     return;
   }
 #endif
-  for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(w.value[k]), cv.step);
+  uint64_t value[4];
+  window_values(rec, w, value);
+#if KEYANIM_SSE2
+  if (vw <= 31) {
+    dequantize4(_mm_set_epi32(static_cast<int32_t>(value[3]), static_cast<int32_t>(value[2]),
+                              static_cast<int32_t>(value[1]), static_cast<int32_t>(value[0])),
+                low, cv.step, out);
+    return;
+  }
+#endif
+  for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(value[k]), cv.step);
 }
 
 // The image's arrays for one block, loaded once per pose rather than once per curve.
@@ -90,10 +113,11 @@ BlockView block_view(const Image& img, const Position& at) noexcept {
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t curve, Batch& b, uint32_t i) noexcept {
   const Curve& cv = v.curves[curve];
+  const uint8_t* rec = v.payload + v.offsets[curve];
   Window w;
-  read_window<kPopcnt>(v.payload + v.offsets[curve], cv.base_bits, v.upto, w);
+  read_window<kPopcnt>(rec, cv.base_bits, v.upto, w);
   std::memcpy(b.frames[i], w.frame, sizeof w.frame);
-  dequantize4(w, cv, b.values[i]);
+  dequantize4(rec, w, cv, b.values[i]);
 }
 
 // A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
@@ -242,9 +266,9 @@ template <bool kPopcnt>
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
     for (uint32_t i = 0; i < blocked; ++i) {
       // The record a few curves ahead: its address needs a load first, so a cold clip's misses
-      // overlap only if they are asked for early.
-      if (base + i + kPrefetchAhead < img.block_curves)
-        __builtin_prefetch(view.payload + view.offsets[base + i + kPrefetchAhead]);
+      // overlap only if they are asked for early. Past the block's last curve this reads the
+      // next block's offsets or the padding (Image::record_offset): a harmless prefetch.
+      __builtin_prefetch(view.payload + view.offsets[base + i + kPrefetchAhead]);
       gather<kPopcnt>(view, base + i, b, i);
     }
     for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
@@ -254,7 +278,8 @@ template <bool kPopcnt>
                  img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
   };
   auto emit = [&](const float* res, uint32_t base, uint32_t m) {
-    for (uint32_t i = 0; i < m; ++i) out[img.curves[base + i].channel] = res[i];
+    const uint32_t* channel = img.curve_channel.data() + base;
+    for (uint32_t i = 0; i < m; ++i) out[channel[i]] = res[i];
   };
   run_chunks(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
 }
@@ -322,7 +347,7 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
   Window w;
   read_window<false>(rec, cv.base_bits, frames_upto(at.t), w);
   float v[4];
-  dequantize4(w, cv, v);
+  dequantize4(rec, w, cv, v);
   const int32_t start = static_cast<int32_t>(at.block << kBlockShift);
   for (int i = 0; i < 4; ++i) s.k[i] = w.frame[i] + start, s.v[i] = v[i];
   // Where key j+3 is: the block keys after key j+2, or the context keys after the block.
