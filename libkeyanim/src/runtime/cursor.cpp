@@ -112,7 +112,8 @@ void sample_playback(const Image& img, Cursor::State& st, float f, float* out) n
     const F4 v = select(F4::load_mask(&st.linear[i]), linear_value(o.p0, o.d, u), hermite(o, u));
     select(F4::load_mask(&st.direct[i]), F4::load(&st.value[i]), v).store(&st.result[i]);
   }
-  for (uint32_t i = 0; i < n; ++i) out[img.curves[i].channel] = st.result[i];
+  const uint32_t* channel = img.curve_channel.data();
+  for (uint32_t i = 0; i < n; ++i) out[channel[i]] = st.result[i];
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
 }
 
