@@ -166,7 +166,7 @@ bool verify_and_tighten(const Job& job, uint32_t round, Budgets& budgets, FrameM
       const uint32_t f = list[i].frame;
       at_frame.clear();
       for (; i < list.size() && list[i].frame == f; ++i)
-        at_frame.push_back({list[i].node, tighten_margin(round) * job.tol_units / list[i].error, list[i].shell});
+        at_frame.push_back({list[i].node, tighten_margin(round) * job.tol_units / list[i].error, list[i].shell != 0});
       budgets.tighten(f, at_frame);
       any = true;
     }

@@ -155,7 +155,7 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
     bool frame_over = false;
     for (size_t d = 0; d < nodes; ++d) {
       if (!w.measure[d] || w.error[d] <= tol) continue;
-      over.push_back({f, uint32_t(d), w.error[d], w.shell_over[d] != 0});
+      over.push_back({f, uint32_t(d) & 0x7FFFFFFFu, w.shell_over[d] != 0u, w.error[d]});  // nodes < 2^31
       frame_over = true;
     }
     check[f] = frame_over ? FrameMarks::kOver : 0;

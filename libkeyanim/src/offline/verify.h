@@ -57,12 +57,14 @@ void changed_ranges(const EncodedChannel& before, const EncodedChannel& after, u
                     std::vector<std::pair<uint32_t, uint32_t>>& out);
 
 // A node farther from its original than the tolerance at some frame.
+// 16 bytes: a first round can hold one per node and frame of the clip.
 struct OverNode {
   uint32_t frame = 0;
-  uint32_t node = 0;
-  double error = 0.0;  // file length units: the largest distance among the node's measured points
-  bool shell = false;  // a shell point is over (then the node's own rotation moves it too)
+  uint32_t node : 31 = 0;
+  uint32_t shell : 1 = 0;  // a shell point is over (then the node's own rotation moves it too)
+  double error = 0.0;      // file length units: the largest distance among the node's measured points
 };
+static_assert(sizeof(OverNode) == 16);
 
 // What to verify, frame by frame, and which nodes may have moved there.
 class FrameMarks {

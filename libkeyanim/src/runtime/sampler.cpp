@@ -70,7 +70,7 @@ Position position(const Image& img, float f) noexcept {
 
 [[gnu::always_inline]] inline void dequantize4(const uint8_t* rec, const Window& w, const Curve& cv, float* out) noexcept {
   const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
-  const uint32_t vw = w.value_bits;
+  [[maybe_unused]] const uint32_t vw = w.value_bits;  // unused without SSE2
 #if KEYANIM_SSE2
   if (vw <= 14) {  // the usual widths: the four values in one load, split in two 64-bit lanes
     uint64_t x;
