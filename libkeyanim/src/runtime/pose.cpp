@@ -11,20 +11,15 @@
 namespace keyanim::internal {
 namespace {
 
-// q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w).
-// Each component is one product with c plus one signed product with s.
-inline void rotate_by(float* q, uint32_t axis, float s, float c) noexcept {
-  const float x = q[0], y = q[1], z = q[2], w = q[3];
-  switch (axis) {
-    case 0: q[0] = w * s + x * c, q[1] = y * c + z * s, q[2] = z * c - y * s, q[3] = w * c - x * s; break;
-    case 1: q[0] = x * c - z * s, q[1] = w * s + y * c, q[2] = z * c + x * s, q[3] = w * c - y * s; break;
-    default: q[0] = x * c + y * s, q[1] = y * c - x * s, q[2] = w * s + z * c, q[3] = w * c - z * s; break;
-  }
-}
-
+// q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w):
+// each component is one product with c plus one signed product with s,
+//   X: (x c + w s, y c + z s, z c - y s, w c - x s)
+//   Y: (x c - z s, y c + w s, z c + x s, w c - y s)
+//   Z: (x c + y s, y c - x s, z c + w s, w c - z s).
 #if KEYANIM_SSE2
-// The same in one register: q c + t s, t a signed permutation of q per axis. The products and
-// sums are those above (a + (-b) is a - b, and addition commutes), so the bits are the same.
+// In one register: q c + t s, t a signed permutation of q per axis. The products and sums are
+// those above (a + (-b) is a - b, and addition commutes), so the bits are the scalar twin's
+// (tests/scalar checks it).
 [[gnu::always_inline]] inline __m128 rotate_by(__m128 q, uint32_t axis, float s, float c) noexcept {
   const __m128 neg23 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, INT32_MIN, 0, 0));
   const __m128 neg03 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, 0, INT32_MIN));
@@ -36,6 +31,15 @@ inline void rotate_by(float* q, uint32_t axis, float s, float c) noexcept {
     default: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(2, 3, 0, 1)), neg13); break;  // (y, -x, w, -z)
   }
   return _mm_add_ps(_mm_mul_ps(q, _mm_set1_ps(c)), _mm_mul_ps(t, _mm_set1_ps(s)));
+}
+#else
+inline void rotate_by(float* q, uint32_t axis, float s, float c) noexcept {
+  const float x = q[0], y = q[1], z = q[2], w = q[3];
+  switch (axis) {
+    case 0: q[0] = x * c + w * s, q[1] = y * c + z * s, q[2] = z * c - y * s, q[3] = w * c - x * s; break;
+    case 1: q[0] = x * c - z * s, q[1] = y * c + w * s, q[2] = z * c + x * s, q[3] = w * c - y * s; break;
+    default: q[0] = x * c + y * s, q[1] = y * c - x * s, q[2] = z * c + w * s, q[3] = w * c - z * s; break;
+  }
 }
 #endif
 
