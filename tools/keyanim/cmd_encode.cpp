@@ -22,7 +22,7 @@ const char* const kEncodeHelp =
     "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--shell D|D%]\n"
     "                      [--keys MODE] [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
     "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
-    "                      [--report R.jsonl] [--error E|E%] [--keys MODE] [-j N] [-f]\n"
+    "                      [--report R.jsonl] [--error E|E%] [--shell D|D%] [--keys MODE] [-j N] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode): every joint,\n"
     "End Site and shell point (--shell) stays within --error of the original.\n"
     "  -o, --output FILE     output (default: IN with .kanim; '-' = standard output).\n"
