@@ -46,7 +46,6 @@ inline constexpr size_t kPayloadPadding = 8;  // so that an 8-byte load at any r
 struct Curve {
   int64_t q_base = 0;    // smallest q of the curve
   double step = 1.0;
-  uint32_t channel = 0;  // output column
   uint32_t base_bits = 0;  // wc
   uint32_t list_first = 0, list_count = 0;  // a list curve's keys in Image::list_*
 };
@@ -97,7 +96,7 @@ struct Image {
   std::vector<float> first_frame, last_frame;  // K_0 and K_{n-1}
   std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
   std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
-  std::vector<uint32_t> curve_channel;   // curves[i].channel, contiguous: a pose's scatter
+  std::vector<uint32_t> curve_channel;   // curve i's output column (channel)
   uint32_t block_count = 0;
   // [block * block_curves + curve]: byte offset in payload; kPrefetchRecords extra zeros at the
   // end, so that the sampler may read the offset of a record a few curves ahead unchecked.

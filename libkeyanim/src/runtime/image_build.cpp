@@ -212,7 +212,6 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
       const auto [lo, hi] = std::minmax_element(q, q + n);
       cv.q_base = *lo;
       cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
-      cv.channel = static_cast<uint32_t>(c);
       if (pass == 1) {
         cv.list_first = static_cast<uint32_t>(img->list_frames.size());
         cv.list_count = n;
@@ -227,7 +226,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
       img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
       img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
       img->curves.push_back(cv);
-      img->curve_channel.push_back(cv.channel);
+      img->curve_channel.push_back(static_cast<uint32_t>(c));
     }
     if (pass == 0) img->block_curves = static_cast<uint32_t>(img->curves.size());
   }
@@ -248,7 +247,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   std::vector<RecordPlan> plans(records);
   for (size_t i = 0; i < nb; ++i) {
     const Curve& cv = img->curves[i];
-    const SourceChannel& sc = src.channels[cv.channel];
+    const SourceChannel& sc = src.channels[img->curve_channel[i]];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
     int64_t first = 0, last = 0;  // the block's keys: [first, last)
     for (uint32_t b = 0; b < img->block_count; ++b) {
@@ -271,7 +270,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
   img->payload.assign(total + kPayloadPadding, 0);
   for (size_t i = 0; i < nb; ++i) {
     const Curve& cv = img->curves[i];
-    const SourceChannel& sc = src.channels[cv.channel];
+    const SourceChannel& sc = src.channels[img->curve_channel[i]];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
     for (uint32_t b = 0; b < img->block_count; ++b) {
       const size_t r = size_t(b) * nb + i;
