@@ -16,12 +16,13 @@ import sys
 TIMING_HEADER = re.compile(r"enc ms\s+dec ms\s*$")
 
 
-def parse(readme):
-    """[(command, [lines the README shows it print])] of every session block (a fenced block whose
-    first line starts with '$ '), in order."""
+def parse(lines):
+    """[(command, [lines the README shows it print], (first, end))] of every session block (a
+    fenced block whose first line starts with '$ '), in order; lines[first:end] are the shown
+    output's lines."""
     result = []
     in_block, is_session, first = False, False, False
-    for line in open(readme, encoding="utf-8").read().splitlines():
+    for i, line in enumerate(lines):
         if line.startswith("```"):
             in_block, is_session, first = not in_block, False, True
             continue
@@ -32,32 +33,23 @@ def parse(readme):
         if not is_session:
             continue
         if line.startswith("$ "):
-            result.append((line[2:], []))
+            result.append((line[2:], [], (i + 1, i + 1)))
         else:
-            result[-1][1].append(line)
+            command, shown, (start, _) = result[-1]
+            shown.append(line)
+            result[-1] = (command, shown, (start, i + 1))
     return result
 
 
-def rewrite(readme, printed):
-    """The README with the output shown under each session command replaced by printed[i] (the
-    i-th command's lines), where the README shows any output for it."""
-    out, i, in_block, is_session, first, skipping = [], -1, False, False, False, False
-    for line in open(readme, encoding="utf-8").read().splitlines():
-        if line.startswith("```"):
-            in_block, is_session, first, skipping = not in_block, False, True, False
-        elif in_block and first:
-            is_session, first = line.startswith("$ "), False
-        if is_session and line.startswith("$ "):
-            i += 1
-            out.append(line)
-            skipping = False
-            continue
-        if is_session and in_block and not line.startswith("```"):
-            if not skipping:
-                out.extend(printed[i])
-                skipping = True
-            continue
-        out.append(line)
+def rewrite(readme, lines, commands, printed):
+    """The README with the output shown under each session command replaced by what it printed
+    (printed[i] for the i-th command), where the README shows any output for it."""
+    out, at = [], 0
+    for (_, shown, (start, end)), actual in zip(commands, printed):
+        if shown:
+            out += lines[at:start] + actual
+            at = end
+    out += lines[at:]
     with open(readme, "w", encoding="utf-8") as f:
         f.write("\n".join(out) + "\n")
 
@@ -84,12 +76,13 @@ def same(expected, actual):
 def main():
     write = sys.argv[1:2] == ["--write"]
     readme = sys.argv[-1]
-    commands = parse(readme)
+    lines = open(readme, encoding="utf-8").read().splitlines()
+    commands = parse(lines)
     if not commands:
         print("FAIL: no session in", readme)
         return 1
     printed = []
-    for command, expected in commands:
+    for command, expected, _ in commands:
         p = subprocess.run(["bash", "-c", command], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            text=True, timeout=600)
         actual = p.stdout.rstrip("\n").split("\n") if p.stdout.strip() else []
@@ -104,7 +97,7 @@ def main():
             print("\n".join(expected))
             return 1
     if write:
-        rewrite(readme, printed)
+        rewrite(readme, lines, commands, printed)
         print(f"readme session: {readme} shows what its {len(commands)} commands print now")
         return 0
     print(f"readme session: {len(commands)} commands as the README shows them")
