@@ -38,7 +38,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/metrics.h"
-#include "acl_compare.h"
+#include "keyanim/offline/acl_compare.h"
 #include "long_clip.h"
 
 namespace fs = std::filesystem;
@@ -221,9 +221,9 @@ int bench_main(int argc, char** argv) {
     return 1;
   }
   std::string acl_error;
-  const auto acl = cli::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
+  const auto acl = offline::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
   if (!acl_error.empty()) std::cerr << "bench_codec: " << acl_error << " (no comparison with ACL)\n";
-  std::map<std::string, std::vector<cli::RatioEntry>> ratios;  // tolerance -> per file
+  std::map<std::string, std::vector<offline::RatioEntry>> ratios;  // tolerance -> per file
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(corpus))
     if (e.path().extension() == ".bvh" && e.path().string().find(filter) != std::string::npos) files.push_back(e.path());
@@ -287,9 +287,9 @@ int bench_main(int argc, char** argv) {
                 {"encode_over_parse", c.encode_ms / parse_ms[1]}});
       const auto it = acl.find(p.filename().string());
       if (it != acl.end() && !it->second.rows.empty()) {
-        nlohmann::json a = cli::acl_at(it->second, c.max_error_replace);
+        nlohmann::json a = offline::acl_at(it->second, c.max_error_replace);
         a["ratio"] = double(c.bytes) / a["bytes"].get<double>();
-        a["group"] = cli::comparison_group(it->second);
+        a["group"] = offline::comparison_group(it->second);
         r["acl_at_equal_error"] = a;
         r["smaller_than_acl"] = double(c.bytes) < a["bytes"].get<double>();
         ratios[tol].push_back({a["group"].get<std::string>(), p.filename().string(), a["ratio"].get<double>()});
@@ -327,7 +327,7 @@ int bench_main(int argc, char** argv) {
   }
   out["summary_cmu_120fps"] = summary;
   nlohmann::json groups = nlohmann::json::object();
-  for (const auto& [tol, entries] : ratios) groups[tol] = cli::group_summary(entries);
+  for (const auto& [tol, entries] : ratios) groups[tol] = offline::group_summary(entries);
   out["acl_groups"] = groups;  // per tolerance, per group: files, median_ratio, worst_ratio, worst_file
   out["encode_over_parse_1thread"] = summary.contains(tolerances[0]) ? summary[tolerances[0]]["median_encode_over_parse"] : nlohmann::json(nullptr);
   out["encode_over_parse_tolerance"] = tolerances[0];

@@ -36,7 +36,7 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
-#include "acl_compare.h"
+#include "keyanim/offline/acl_compare.h"
 #include "runtime/clip_access.h"
 
 namespace {
@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
     std::sort(files.begin(), files.end());
     std::vector<double> over_acl;
     std::string acl_error;  // ACL under the metric keyanim's encoder guarantees: the shell metric
-    const auto acl = keyanim::cli::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
+    const auto acl = keyanim::offline::read_acl_table((fs::path(KEYANIM_ANCHORS_DIR) / "acl_shell.tsv").string(), acl_error);
     if (!acl_error.empty()) std::cerr << "bench_decode: " << acl_error << " (no comparison with ACL)\n";
     for (const fs::path& p : files) {
       Motion mm;
@@ -262,7 +262,7 @@ int main(int argc, char** argv) {
       r["file"] = p.filename().string();
       const auto it = acl.find(p.filename().string());
       if (it != acl.end() && !it->second.rows.empty()) {
-        const double bytes = keyanim::cli::acl_at(it->second, r.value("max_error", 0.0))["bytes"].get<double>();
+        const double bytes = keyanim::offline::acl_at(it->second, r.value("max_error", 0.0))["bytes"].get<double>();
         r["acl_bytes_at_equal_error"] = bytes;
         r["memory_over_acl"] = r["memory_bytes"].get<double>() / bytes;
         over_acl.push_back(r["memory_over_acl"].get<double>());

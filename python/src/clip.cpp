@@ -148,7 +148,7 @@ void register_clip(py::module_& m) {
   cls.def_property_readonly(
       "info",
       [](const PyClip& c) {
-        py::dict info = to_python(cli::kanim_info(c.file.value_or(""), c.bytes, c.clip));
+        py::dict info = to_python(offline::kanim_info(c.file.value_or(""), c.bytes, c.clip));
         if (!c.file) info["file"] = py::none();
         return info;
       },

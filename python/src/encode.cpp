@@ -101,7 +101,7 @@ py::tuple encode(const PyMotion& m, const py::object& error, const py::object& k
     bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
     encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  py::dict report = to_python(cli::encode_summary("", "", m.motion, m.bvh_bytes.value_or(0), settings, result,
+  py::dict report = to_python(offline::encode_summary("", "", m.motion, m.bvh_bytes.value_or(0), settings, result,
                                                   bytes.size(), encode_ms));
   report["input"] = m.source ? py::object(text(*m.source)) : py::object(py::none());
   report["output"] = py::none();

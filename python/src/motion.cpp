@@ -187,7 +187,7 @@ void register_motion(py::module_& m) {
           py::gil_scoped_release unlocked;
           report = offline::measure_error(original.motion, decoded.motion, distance);
         }
-        return to_python(cli::error_json(original.motion.skeleton, report));
+        return to_python(offline::error_json(original.motion.skeleton, report));
       },
       py::arg("original"), py::arg("decoded"), py::kw_only(), py::arg("shell") = "2%",
       "World-space distance between two motions of the same skeleton and frame count, over every\n"

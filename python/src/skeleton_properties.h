@@ -1,7 +1,7 @@
 // The skeleton's properties, the same on keyanim.Motion and keyanim.Clip. Nodes are the joints
 // and End Sites, in file order (parents first); arrays over nodes use this order.
 #pragma once
-#include "report.h"  // tools/keyanim: node_name, the CLI's display name of a node
+#include "keyanim/offline/report.h"  // node_name: a node's display name, as the reports give it
 
 namespace keyanim::python {
 
@@ -13,7 +13,7 @@ void def_skeleton_properties(Class& cls, Get skeleton_of) {
       [skeleton_of](const Self& self) {
         const Skeleton& s = skeleton_of(self);
         py::list names;
-        for (uint32_t i = 0; i < s.joints.size(); ++i) names.append(text(cli::node_name(s, i)));
+        for (uint32_t i = 0; i < s.joints.size(); ++i) names.append(text(offline::node_name(s, i)));
         return names;
       },
       "Name of every node (joints and End Sites, in file order; an unnamed End Site is\n"
@@ -52,7 +52,7 @@ void def_skeleton_properties(Class& cls, Get skeleton_of) {
         const Skeleton& s = skeleton_of(self);
         py::list names;
         for (uint32_t i = 0; i < s.joints.size(); ++i)
-          for (ChannelType t : s.joints[i].channels) names.append(text(cli::node_name(s, i) + ":" + channel_name(t)));
+          for (ChannelType t : s.joints[i].channels) names.append(text(offline::node_name(s, i) + ":" + channel_name(t)));
         return names;
       },
       "Name of every channel, 'JOINT:Xrotation' (as `keyanim plot --channel` takes them), in\n"

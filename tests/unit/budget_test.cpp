@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "offline/budget.h"
+#include "offline/encode/budget.h"
 
 using namespace keyanim;
 using namespace keyanim::offline;

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <random>
 
-#include "offline/channel_fit.h"
+#include "offline/encode/channel_fit.h"
 
 using namespace keyanim;
 using namespace keyanim::offline;

@@ -2,7 +2,7 @@
 #include <doctest/doctest.h>
 
 #include "keyanim/version.h"
-#include "offline/notes.h"
+#include "offline/encode/notes.h"
 
 using namespace keyanim::offline;
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "keyanim/offline/encode.h"
-#include "offline/signals.h"
+#include "offline/encode/signals.h"
 
 using namespace keyanim;
 using namespace keyanim::offline;

@@ -9,7 +9,7 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/metrics.h"
-#include "offline/verify.h"
+#include "offline/encode/verify.h"
 #include "shell_reference.h"
 
 using namespace keyanim;

@@ -13,7 +13,7 @@
 #include "io.h"
 #include "manifest.h"
 #include "progress.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 #include "settings.h"
 
 namespace keyanim::cli {
@@ -67,8 +67,8 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   Encoded e;
-  e.summary = encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);
-  if (error_given) e.warning = tolerance_warning(settings, result.tolerance_units, result.error.max_error);
+  e.summary = offline::encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);
+  if (error_given) e.warning = offline::tolerance_warning(settings, result.tolerance_units, result.error.max_error);
   output.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   output.commit();
   return e;

@@ -10,7 +10,7 @@
 #include <optional>
 #include <sstream>
 
-#include "acl_compare.h"
+#include "keyanim/offline/acl_compare.h"
 #include "batch.h"
 #include "eval_report.h"
 #include "commands.h"
@@ -20,7 +20,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/metrics.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 #include "settings.h"
 
 namespace keyanim::cli {
@@ -63,20 +63,20 @@ size_t zstd19_size(const std::vector<uint8_t>& text) {
 }
 
 // ACL at this file's error, from the table (nothing when the table has no such file).
-void compare_with_acl(const std::map<std::string, AclFile>& acl, const std::string& path, const offline::ErrorReport& e,
+void compare_with_acl(const std::map<std::string, offline::AclFile>& acl, const std::string& path, const offline::ErrorReport& e,
                       double bytes, nlohmann::json& result) {
   const auto it = acl.find(std::filesystem::path(path).filename().string());
   if (it == acl.end() || it->second.rows.empty()) return;
   const double error = e.reading_max[size_t(PositionReading::replace)];
-  nlohmann::json a = acl_at(it->second, error);
+  nlohmann::json a = offline::acl_at(it->second, error);
   a["error"] = error;
-  a["group"] = comparison_group(it->second);
+  a["group"] = offline::comparison_group(it->second);
   a["ratio"] = bytes / a["bytes"].get<double>();
   result["acl"] = a;
 }
 
 nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& runs,
-                         const std::map<std::string, AclFile>& acl, const Globals& g) {
+                         const std::map<std::string, offline::AclFile>& acl, const Globals& g) {
   const std::vector<uint8_t> text = read_input(path, Kind::bvh, g);
   const auto t0 = Clock::now();
   const offline::Motion m = load_bvh_bytes(path, text, g);
@@ -117,7 +117,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
                       {"ratio_raw_f32", raw / n},
                       {"ratio_bvh", double(text.size()) / n},
                       {"ratio_bvh_zstd19", double(z19) / n},
-                      {"error", error_json(m.skeleton, e)},
+                      {"error", offline::error_json(m.skeleton, e)},
                       {"encode_ms", encode_ms},
                       {"decode_ms", decode_ms}};
     // Only error mode applies the tolerance; the other modes say whether --error held.
@@ -128,7 +128,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
       result["error_limit"] = runs[r].tolerance;
       result["error_limit_units"] = enc.tolerance_units;
       result["error_limit_met"] = e.max_error <= enc.tolerance_units;
-      result["warning"] = tolerance_warning(settings, enc.tolerance_units, e.max_error);
+      result["warning"] = offline::tolerance_warning(settings, enc.tolerance_units, e.max_error);
     }
     compare_with_acl(acl, path, e, n, result);
     file["results"].push_back(std::move(result));
@@ -138,7 +138,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
 
 // Per setting (key mode and tolerance), per group: the median and worst ratio against ACL.
 nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
-  std::map<std::string, std::vector<RatioEntry>> runs;
+  std::map<std::string, std::vector<offline::RatioEntry>> runs;
   for (const auto& f : files) {
     if (f.is_null()) continue;
     for (const auto& r : f["results"]) {
@@ -150,7 +150,7 @@ nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
     }
   }
   nlohmann::json out = nlohmann::json::object();
-  for (const auto& [run, entries] : runs) out[run] = group_summary(entries);
+  for (const auto& [run, entries] : runs) out[run] = offline::group_summary(entries);
   return out;
 }
 
@@ -180,10 +180,10 @@ int cmd_eval(const Argv& argv, Globals& g) {
   if (std::count(args.positional().begin(), args.positional().end(), "-") > 1)
     fail(kUsage, "only one input can be standard input");
   const std::vector<EvalRun> runs = eval_runs(args);
-  std::map<std::string, AclFile> acl;
+  std::map<std::string, offline::AclFile> acl;
   if (auto table = args.get("--acl")) {
     std::string why;
-    acl = read_acl_table(*table, why);
+    acl = offline::read_acl_table(*table, why);
     if (!why.empty()) fail(kBadInput, why);
   }
   const std::vector<std::string> files = expand_inputs(args.positional());

@@ -6,7 +6,7 @@
 #include "commands.h"
 #include "escape.h"
 #include "io.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 
 namespace keyanim::cli {
 
@@ -63,8 +63,8 @@ int cmd_info(const Argv& argv, Globals& g) {
   if (args.positional().size() != 1) fail(kUsage, "info takes one file");
   const std::string in = args.positional()[0];
   const std::vector<uint8_t> bytes = read_input(in, Kind::either, g);
-  const nlohmann::json j = looks_like_kanim(bytes) ? kanim_info(in, bytes.size(), load_kanim(in, bytes, g))
-                                                  : bvh_info(in, bytes.size(), load_bvh_bytes(in, bytes, g));
+  const nlohmann::json j = looks_like_kanim(bytes) ? offline::kanim_info(in, bytes.size(), load_kanim(in, bytes, g))
+                                                  : offline::bvh_info(in, bytes.size(), load_bvh_bytes(in, bytes, g));
   if (args.has("--json")) std::cout << json_text(j) << "\n"; else print_text(j);
   return kOk;
 }

@@ -11,6 +11,7 @@
 #include "keyanim/clip.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
+#include "keyanim/offline/report.h"
 #include "settings.h"
 
 namespace keyanim::cli {
@@ -126,7 +127,7 @@ int cmd_render(const Argv& argv, Globals& g) {
     std::cerr << printable(in + " -> " + out) << ": frame " << frame;
     if (series.size() == 2)
       std::cerr << ", largest distance " << fig.worst_distance << " ("
-                << printable(figure_node_name(first.skeleton, fig.worst_node)) << ")";
+                << printable(offline::node_name(first.skeleton, fig.worst_node)) << ")";
     std::cerr << "\n";
   }
   return kOk;

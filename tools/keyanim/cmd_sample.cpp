@@ -6,7 +6,7 @@
 #include "escape.h"
 #include "io.h"
 #include "keyanim/offline/fk.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 
 namespace keyanim::cli {
 
@@ -54,7 +54,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   for (uint32_t i = 0; i < sk.joints.size(); ++i) {
     const Joint& j = sk.joints[i];
     if (only >= 0 && int32_t(i) != only) continue;
-    nlohmann::json e = {{"name", node_name(sk, i)}};
+    nlohmann::json e = {{"name", offline::node_name(sk, i)}};
     if (args.has("--world")) {
       e["position"] = {world[i][0], world[i][1], world[i][2]};
     } else {

@@ -10,7 +10,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/notes.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 #include "settings.h"
 
 namespace keyanim::cli {
@@ -70,7 +70,7 @@ int cmd_verify(const Argv& argv, Globals& g) {
       const offline::Motion back = or_fail(kBadInput, in + ": ", [&] { return offline::decode_motion(clip); });
       // The same layout: checked above.
       const offline::ErrorReport e = offline::measure_error(orig, back, shell_units(shell, clip, orig));
-      j["error"] = error_json(orig.skeleton, e);
+      j["error"] = offline::error_json(orig.skeleton, e);
       if (limit) {
         const offline::EncodeSettings& s = *limit;
         const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::reference_size(orig) : s.tolerance;
@@ -80,7 +80,7 @@ int cmd_verify(const Argv& argv, Globals& g) {
           why = "error " + std::to_string(e.max_error) + " exceeds " + std::to_string(units);
         }
       }
-      if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + error_text(orig.skeleton, e)) << "\n";
+      if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + offline::error_text(orig.skeleton, e)) << "\n";
     }
   }
   j["ok"] = ok;

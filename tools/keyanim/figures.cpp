@@ -8,6 +8,7 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
+#include "keyanim/offline/report.h"
 #include "svg.h"
 
 namespace keyanim::cli {
@@ -31,8 +32,6 @@ std::string short_number(double v) {
 }
 
 }  // namespace
-
-std::string figure_node_name(const Skeleton& s, uint32_t node) { return offline::point_name(s, node, 0); }
 
 std::optional<uint32_t> find_channel(const Skeleton& skeleton, const std::string& spec, std::string& error) {
   // The last colon splits: a joint name may contain one, a channel name never does.
@@ -248,7 +247,7 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
   svg::legend(doc, {left, 44}, entries);
   const Skeleton& sk = series.front().motion->skeleton;
   if (series.size() == 2)
-    doc.text({left, 64}, "largest distance: " + figure_node_name(sk, fig.worst_node) + " " +
+    doc.text({left, 64}, "largest distance: " + offline::node_name(sk, fig.worst_node) + " " +
                              short_number(fig.worst_distance) + " file units",
              attr("class", "subtitle") + " fill=\"#444\"");
 
@@ -282,7 +281,7 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
       doc.circle(p, 8.0, attr("class", "worst") + " fill=\"none\" stroke=\"#c00\" stroke-width=\"1.2\"");
       // Beside the circle or in a corner of the view, wherever the label covers least of the
       // figure (joints and points along the bones counted), joined to the circle by a leader line.
-      const std::string label = figure_node_name(sk, fig.worst_node) + " " + short_number(fig.worst_distance);
+      const std::string label = offline::node_name(sk, fig.worst_node) + " " + short_number(fig.worst_distance);
       const svg::Rect& area = ax.area();
       const double tw = 7.0 * static_cast<double>(label.size()) + 4.0, th = 16.0, inset = 6.0;
       const svg::Rect candidates[] = {

@@ -68,7 +68,4 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
 // channel layout, so that their poses can be compared node by node.
 bool same_skeleton(const Skeleton& a, const Skeleton& b);
 
-// Display name of a node: its name, or "End Site of PARENT".
-std::string figure_node_name(const Skeleton& s, uint32_t node);
-
 }  // namespace keyanim::cli

@@ -11,7 +11,7 @@
 #include "keyanim/offline/gltf.h"
 #include "keyanim/offline/metrics.h"
 #include "progress.h"
-#include "report.h"
+#include "keyanim/offline/report.h"
 #include "settings.h"
 
 namespace keyanim::cli {

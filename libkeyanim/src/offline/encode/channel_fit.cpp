@@ -1,4 +1,4 @@
-#include "offline/channel_fit.h"
+#include "offline/encode/channel_fit.h"
 
 #include <algorithm>
 #include <cmath>

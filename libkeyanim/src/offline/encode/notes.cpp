@@ -1,4 +1,4 @@
-#include "offline/notes.h"
+#include "offline/encode/notes.h"
 
 #include <charconv>
 #include <cmath>

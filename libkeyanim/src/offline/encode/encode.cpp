@@ -19,12 +19,12 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/curvature.h"
 #include "keyanim/offline/keyframes.h"
-#include "offline/budget.h"
-#include "offline/channel_fit.h"
-#include "offline/notes.h"
+#include "offline/encode/budget.h"
+#include "offline/encode/channel_fit.h"
+#include "offline/encode/notes.h"
+#include "offline/encode/signals.h"
+#include "offline/encode/verify.h"
 #include "offline/parallel.h"
-#include "offline/signals.h"
-#include "offline/verify.h"
 
 namespace keyanim::offline {
 namespace {

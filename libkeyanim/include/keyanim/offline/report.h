@@ -8,7 +8,7 @@
 #include "keyanim/offline/encode.h"
 #include "keyanim/skeleton.h"
 
-namespace keyanim::cli {
+namespace keyanim::offline {
 
 // Display name of a node: its name, or "End Site of PARENT".
 std::string node_name(const Skeleton& s, uint32_t node);
@@ -35,4 +35,4 @@ nlohmann::json encode_summary(const std::string& input, const std::string& outpu
 nlohmann::json bvh_info(const std::string& file, uint64_t bytes, const offline::Motion& motion);
 nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& clip);
 
-}  // namespace keyanim::cli
+}  // namespace keyanim::offline

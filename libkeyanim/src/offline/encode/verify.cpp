@@ -1,4 +1,4 @@
-#include "offline/verify.h"
+#include "offline/encode/verify.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/metrics.h"
-#include "offline/channel_fit.h"
+#include "offline/encode/channel_fit.h"
 #include "offline/parallel.h"
 
 namespace keyanim::offline {

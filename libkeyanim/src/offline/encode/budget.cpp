@@ -1,4 +1,4 @@
-#include "offline/budget.h"
+#include "offline/encode/budget.h"
 
 #include <algorithm>
 #include <array>

@@ -1,11 +1,11 @@
-#include "acl_compare.h"
+#include "keyanim/offline/acl_compare.h"
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
-namespace keyanim::cli {
+namespace keyanim::offline {
 namespace {
 
 std::vector<std::string> fields(const std::string& line) {
@@ -101,4 +101,4 @@ nlohmann::json group_summary(const std::vector<RatioEntry>& entries) {
   return out;
 }
 
-}  // namespace keyanim::cli
+}  // namespace keyanim::offline

@@ -16,6 +16,7 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/encode.h"
+#include "keyanim/offline/report.h"
 #include "svg.h"
 
 using namespace keyanim;
@@ -256,7 +257,7 @@ TEST_CASE("render labels the node the error metrics name at their worst frame") 
   CHECK(count(fig.svg, "class=\"bone\"") == 2 * 2 * bones);
   CHECK(count(fig.svg, "class=\"joint\"") == 2 * 2 * m.skeleton.joints.size());
   CHECK(count(fig.svg, "class=\"worst\"") == 2);
-  CHECK(fig.svg.find(cli::figure_node_name(m.skeleton, r.error.worst_joint)) != std::string::npos);
+  CHECK(fig.svg.find(offline::node_name(m.skeleton, r.error.worst_joint)) != std::string::npos);
   CHECK(fig.svg.find(">x (file units)</text>") != std::string::npos);
   CHECK(fig.svg.find(">z (file units)</text>") != std::string::npos);
   CHECK(count(fig.svg, ">y (file units)</text>") == 2);

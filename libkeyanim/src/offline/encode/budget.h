@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "keyanim/offline/motion.h"
-#include "offline/channel_fit.h"
+#include "offline/encode/channel_fit.h"
 
 namespace keyanim::offline {
 

@@ -1,4 +1,4 @@
-#include "report.h"
+#include "keyanim/offline/report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/notes.h"
 
-namespace keyanim::cli {
+namespace keyanim::offline {
 
 std::string node_name(const Skeleton& s, uint32_t node) { return offline::point_name(s, node, 0); }
 
@@ -174,4 +174,4 @@ nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& c
   return j;
 }
 
-}  // namespace keyanim::cli
+}  // namespace keyanim::offline

@@ -1,4 +1,4 @@
-#include "offline/signals.h"
+#include "offline/encode/signals.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace keyanim::cli {
+namespace keyanim::offline {
 
 struct AclRow {
   double bytes = 0.0, error = 0.0;  // ACL's bytes and its measured error (file units)
@@ -39,4 +39,4 @@ struct RatioEntry {
 };
 nlohmann::json group_summary(const std::vector<RatioEntry>& entries);
 
-}  // namespace keyanim::cli
+}  // namespace keyanim::offline

@@ -1,0 +1,106 @@
+// The loader's parts (internal to load/): the section table, each section's parsing, and the
+// key values of every format version. Every rule of spec/FORMAT.md is checked once, in the
+// order of its section 7, before anything a file declares is allocated; the sampler then
+// trusts the arrays. load.cpp drives them (Loader::run) and is the public door (Clip::load).
+#pragma once
+#include <zstd.h>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "internal/clip_source.h"
+#include "internal/value_coding.h"
+#include "keyanim/clip.h"
+
+namespace keyanim::internal {
+
+// "CLIP", or '?' for bytes that are not printable.
+std::string tag_name(uint32_t tag);
+
+struct TableEntry {
+  uint32_t tag = 0;
+  uint32_t flags = 0;
+  uint64_t stored = 0;
+  uint64_t raw = 0;
+  uint64_t file_offset = 0;   // where the stored bytes start
+  uint64_t entry_offset = 0;  // where the table entry starts
+};
+
+// A section's raw content and how to turn an offset in it into an offset in the file.
+struct Content {
+  const uint8_t* data = nullptr;
+  size_t size = 0;
+  uint64_t file_offset = 0;
+  bool compressed = false;
+  const char* name = "";
+};
+
+struct DctxDeleter {
+  void operator()(ZSTD_DCtx* d) const noexcept { ZSTD_freeDCtx(d); }
+};
+
+class Loader {
+ public:
+  Loader(std::span<const uint8_t> bytes, const DecodeLimits& limits, ErrorInfo* err)
+      : bytes_(bytes), limits_(limits), err_(err) {}
+
+  Status run(ClipSource& parts);  // load.cpp
+
+ private:
+  Status fail(Status s, const char* section, uint64_t offset, std::string detail) {
+    if (err_ != nullptr) {
+      err_->status = s;
+      err_->section = section;
+      err_->byte_offset = offset;
+      err_->detail = std::move(detail);
+    }
+    return s;
+  }
+  // Failure at offset `at` of a section's content.
+  Status fail_in(Status s, const Content& c, size_t at, std::string detail) {
+    if (c.compressed)
+      return fail(s, c.name, c.file_offset,
+                  detail + " (at byte " + std::to_string(at) + " of the decompressed section)");
+    return fail(s, c.name, c.file_offset + at, std::move(detail));
+  }
+
+  Status read_header_and_table();
+  Status get_content(const TableEntry& e, const char* name, Content& out);
+  Status parse_clip(const Content& c, ClipSource& parts);
+  Status parse_skel(const Content& c, ClipSource& parts);
+  Status parse_chan(const Content& c, ClipSource& parts);
+  Status parse_ktim(const Content& c, ClipSource& parts);
+  Status parse_kval(const Content& c, ClipSource& parts);        // 1.x and 2.x: varint planes
+  Status parse_kval_fixed(const Content& c, ClipSource& parts);  // 3.x: fixed-width byte planes
+  // Turns channel ch's residual r (of key i, found at section offset at) into q, checking the
+  // bounds of section 4.5; q and q_prev carry the previous two.
+  Status residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i, uint64_t zigzag, int64_t& q,
+                       int64_t& q_prev, ClipSource& parts);
+
+  std::span<const uint8_t> bytes_;
+  const DecodeLimits& limits_;
+  ErrorInfo* err_;
+
+  uint16_t major_ = 0;
+  uint16_t minor_ = 0;
+  std::vector<TableEntry> table_;
+  int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL
+  int note_index_ = -1;
+  std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx_;
+  // Decompressed sections, alive until parsed. Not zero-filled: a small file declaring a large
+  // section must not make the loader touch (commit) that memory before zstd has produced it.
+  std::vector<std::unique_ptr<uint8_t[]>> buffers_;
+
+  // From CLIP.
+  uint64_t key_count_ = 0;
+  uint32_t node_count_ = 0;
+  uint32_t channel_count_ = 0;
+  // From CHAN, needed by KVAL.
+  std::vector<internal::ValueCoding> codings_;  // all delta in 1.x
+  std::vector<uint8_t> residual_bytes_;         // 3.x
+};
+
+}  // namespace keyanim::internal

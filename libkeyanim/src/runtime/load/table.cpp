@@ -1,0 +1,178 @@
+// The header, the section table, the checksum, and a section's content (zstd-decompressed when
+// it is stored so, with every declared size checked before anything is allocated).
+#include <zlib.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <limits>
+#include <optional>
+
+#include "internal/byte_reader.h"
+#include "internal/format.h"
+#include "internal/zstd_bound.h"
+#include "keyanim/version.h"
+#include "runtime/load/loader.h"
+
+namespace keyanim::internal {
+
+std::string tag_name(uint32_t tag) {
+  std::string s(4, '?');
+  for (int i = 0; i < 4; ++i) {
+    const char ch = static_cast<char>((tag >> (8 * i)) & 0xFF);
+    s[static_cast<size_t>(i)] = (ch >= 0x20 && ch < 0x7F) ? ch : '?';
+  }
+  return s;
+}
+
+Status Loader::read_header_and_table() {
+  const uint8_t* p = bytes_.data();
+  const size_t size = bytes_.size();
+  for (size_t i = 0; i < internal::kSignatureSize; ++i) {
+    if (i >= size) return fail(Status::truncated, "signature", size, "the file ends inside the signature");
+    if (p[i] != internal::kSignature[i])
+      return fail(Status::bad_signature, "signature", i, "not a .kanim file (signature mismatch)");
+  }
+  if (size < internal::kHeaderEnd) return fail(Status::truncated, "header", size, "the file ends inside the header");
+  ByteReader r(p, size);
+  r.skip(internal::kSignatureSize);
+  uint16_t major = 0;
+  uint32_t header_flags = 0, section_count = 0, reserved = 0;
+  r.read(major);
+  r.read(minor_);
+  r.read(header_flags);
+  r.read(section_count);
+  r.read(reserved);
+  if (major < kOldestFormatVersionMajor || major > kFormatVersionMajor)
+    return fail(Status::unsupported_version, "header", 8,
+                "major version " + std::to_string(major) + " (this decoder reads versions " +
+                    std::to_string(kOldestFormatVersionMajor) + " to " + std::to_string(kFormatVersionMajor) + ")");
+  major_ = major;
+  if (header_flags & internal::kHeaderReservedMask)
+    return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
+  if (reserved != 0) return fail(Status::reserved_bits_set, "header", 20, "Header_Reserved is not 0");
+
+  // The table and the checksum must fit: 24 * count + 4 <= size - 24, in subtraction form.
+  const size_t avail = size - internal::kHeaderEnd;
+  if (avail < internal::kChecksumSize ||
+      section_count > (avail - internal::kChecksumSize) / internal::kTableEntrySize)
+    return fail(Status::truncated, "table", size,
+                "the file ends inside the section table of " + std::to_string(section_count) + " entries");
+  table_.resize(section_count);  // bounded by the file size just checked
+  uint64_t pos = internal::kHeaderEnd + uint64_t(section_count) * internal::kTableEntrySize;
+  size_t next_critical = 0;
+  for (uint32_t i = 0; i < section_count; ++i) {
+    TableEntry& e = table_[i];
+    e.entry_offset = internal::kHeaderEnd + uint64_t(i) * internal::kTableEntrySize;
+    r.read(e.tag);
+    r.read(e.flags);
+    r.read(e.stored);
+    r.read(e.raw);
+    e.file_offset = pos;
+    const std::string name = "section " + std::to_string(i) + " (" + tag_name(e.tag) + ")";
+    if (e.flags & internal::kSectionReservedMask)
+      return fail(Status::reserved_bits_set, "table", e.entry_offset + 4, name + ": reserved Section_Flags bits are set");
+    const bool ancillary = (e.flags & internal::kSectionAncillary) != 0;
+    size_t crit = 5;
+    for (size_t k = 0; k < 5; ++k)
+      if (internal::kCriticalTags[k] == e.tag) crit = k;
+    if (crit < 5) {
+      if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
+      if (crit != next_critical)
+        return fail(Status::corrupt, "table", e.entry_offset,
+                    name + ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order");
+      critical_index_[crit] = static_cast<int>(i);
+      ++next_critical;
+    } else if (e.tag == internal::kTagNote) {
+      if (!ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": NOTE must be ancillary");
+      if (note_index_ >= 0) return fail(Status::corrupt, "table", e.entry_offset, name + ": a second NOTE section");
+      note_index_ = static_cast<int>(i);
+    } else if (!ancillary) {
+      return fail(Status::reserved_bits_set, "table", e.entry_offset,
+                  name + ": unknown critical section (this decoder does not know the tag)");
+    }
+    if (!(e.flags & internal::kSectionCompressed) && e.stored != e.raw)
+      return fail(Status::corrupt, "table", e.entry_offset + 8, name + ": uncompressed, but Stored_Size != Raw_Size");
+    if (e.stored > size - pos)
+      return fail(Status::truncated, "table", size, name + ": the file ends before the section's declared end");
+    pos += e.stored;
+  }
+  if (next_critical != 5)
+    return fail(Status::corrupt, "table", internal::kHeaderEnd,
+                std::string("missing critical section ") + tag_name(internal::kCriticalTags[next_critical]));
+  if (size - pos < internal::kChecksumSize) return fail(Status::truncated, "checksum", size, "the file ends inside the checksum");
+  if (size - pos > internal::kChecksumSize)
+    return fail(Status::trailing_bytes, "checksum", pos + internal::kChecksumSize,
+                std::to_string(size - pos - internal::kChecksumSize) + " bytes after the checksum");
+
+  // Everything this decoder will decompress or copy, before anything is.
+  uint64_t raw_total = 0;
+  for (uint32_t i = 0; i < section_count; ++i) {
+    const TableEntry& e = table_[i];
+    const bool known = e.tag == internal::kTagNote || !(e.flags & internal::kSectionAncillary);
+    if (!known) continue;
+    if (e.raw > limits_.max_decompressed_bytes - raw_total || e.raw > limits_.max_decompressed_bytes)
+      return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
+                  "decompressed sections exceed the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
+    raw_total += e.raw;
+  }
+
+  uLong crc = crc32(0L, Z_NULL, 0);
+  for (uint64_t done = 0; done < pos;) {
+    const uInt chunk = static_cast<uInt>(std::min<uint64_t>(pos - done, 1u << 30));
+    crc = crc32(crc, p + done, chunk);
+    done += chunk;
+  }
+  const uint32_t stored_crc = internal::load_le<uint32_t>(p + pos);
+  if (static_cast<uint32_t>(crc) != stored_crc)
+    return fail(Status::checksum_mismatch, "checksum", pos, "CRC-32 of the file does not match its checksum");
+  return Status::ok;
+}
+
+Status Loader::get_content(const TableEntry& e, const char* name, Content& out) {
+  out.name = name;
+  out.file_offset = e.file_offset;
+  const uint8_t* src = bytes_.data() + e.file_offset;
+  const size_t stored = static_cast<size_t>(e.stored);  // <= file size
+  if (!(e.flags & internal::kSectionCompressed)) {
+    out.data = src;
+    out.size = stored;
+    return Status::ok;
+  }
+  out.compressed = true;
+  if (stored < 4 || internal::load_le<uint32_t>(src) != internal::kZstdMagic)
+    return fail(Status::zstd_error, name, e.file_offset, "not a zstd frame");
+  const unsigned long long declared = ZSTD_getFrameContentSize(src, stored);
+  if (declared == ZSTD_CONTENTSIZE_ERROR) return fail(Status::zstd_error, name, e.file_offset, "bad zstd frame header");
+  if (declared == ZSTD_CONTENTSIZE_UNKNOWN)
+    return fail(Status::zstd_error, name, e.file_offset, "the zstd frame does not declare its content size");
+  if (declared != e.raw)
+    return fail(Status::zstd_error, name, e.file_offset,
+                "the zstd frame declares " + std::to_string(declared) + " bytes, Raw_Size is " + std::to_string(e.raw));
+  const size_t frame = ZSTD_findFrameCompressedSize(src, stored);
+  if (ZSTD_isError(frame) || frame != stored)
+    return fail(Status::zstd_error, name, e.file_offset, "Stored_Size is not exactly one zstd frame");
+  if (e.raw > std::numeric_limits<size_t>::max())
+    return fail(Status::limit_exceeded, name, e.file_offset, "section too large for this platform");
+  // Allocate Raw_Size only when the frame's blocks can produce it (zip-bomb headers).
+  const std::optional<uint64_t> bound = internal::zstd_frame_output_bound(src, stored);
+  if (!bound) return fail(Status::zstd_error, name, e.file_offset, "bad zstd block headers");
+  if (*bound < e.raw)
+    return fail(Status::zstd_error, name, e.file_offset,
+                "the zstd frame's blocks can produce at most " + std::to_string(*bound) + " bytes, Raw_Size is " +
+                    std::to_string(e.raw));
+  if (!dctx_) {
+    dctx_.reset(ZSTD_createDCtx());
+    if (!dctx_) return fail(Status::zstd_error, name, e.file_offset, "cannot create a zstd context");
+  }
+  buffers_.emplace_back(new uint8_t[static_cast<size_t>(e.raw) + 1]);  // +1: valid when raw is 0
+  uint8_t* buf = buffers_.back().get();
+  const size_t got = ZSTD_decompressDCtx(dctx_.get(), buf, static_cast<size_t>(e.raw), src, stored);
+  if (ZSTD_isError(got))
+    return fail(Status::zstd_error, name, e.file_offset, std::string("zstd: ") + ZSTD_getErrorName(got));
+  if (got != e.raw) return fail(Status::zstd_error, name, e.file_offset, "the zstd frame decompressed to the wrong size");
+  out.data = buf;
+  out.size = got;
+  return Status::ok;
+}
+
+}  // namespace keyanim::internal

@@ -1,0 +1,200 @@
+// Write -> load round trips: bit-exact equality with to_clip, dequantization, the cursor,
+// sampling entry points and their argument errors, bit-packed keys, and what the writer refuses.
+#include <doctest/doctest.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "keyanim/cardinal.h"
+#include "keyanim/clip.h"
+#include "clip_reference.h"
+#include "keyanim/version.h"
+#include "keyanim/offline/container.h"
+#include "keyanim/offline/decode.h"
+
+#include "crafted.h"
+
+using namespace container_test;
+
+TEST_SUITE("container") {
+
+TEST_CASE("the test machine is little-endian and the test CRC-32 is the standard one") {
+  const uint16_t one = 1;
+  uint8_t b[2];
+  std::memcpy(b, &one, 2);
+  REQUIRE(b[0] == 1);
+  const char* check = "123456789";
+  CHECK(crc32_ref(reinterpret_cast<const uint8_t*>(check), 9) == 0xCBF43926u);
+}
+
+TEST_CASE("write then load equals to_clip bit-exactly") {
+  std::vector<EncodedClip> clips = {vector_rules(), vector_uniform(), vector_single(), vector_long(),
+                                    random_clip(1, 500, 8), random_clip(2, 301, 31), random_clip(3, 2, 3)};
+  for (const auto& e : clips) {
+    CAPTURE(e.frame_count);
+    REQUIRE_NOTHROW(keyanim::offline::validate_encoded_clip(e));
+    const Clip ref = keyanim::offline::to_clip(e);
+    for (int level : {0, 3, 19}) {
+      const auto bytes = keyanim::offline::write_kanim(e, level);
+      REQUIRE(!bytes.empty());
+      const Loaded l = load(bytes);
+      REQUIRE_MESSAGE(l.status == Status::ok, l.err.section << " " << l.err.detail);
+      check_same_clip(l.clip, ref);
+      check_same_samples(l.clip, ref);
+      CHECK(l.clip.version_major() == keyanim::kFormatVersionMajor);
+      CHECK(l.clip.version_minor() == 0);
+    }
+  }
+}
+
+TEST_CASE("key values are dequantized as float of q times step in double") {
+  EncodedClip e = vector_rules();
+  const Loaded l = load(keyanim::offline::write_kanim(e));
+  REQUIRE(l.status == Status::ok);
+  // Channel 11: q = 123456 and -654321 at step 1e-3, computed in double then rounded.
+  const keyanim::test::ChannelKeys k11 = keyanim::test::channel_keys(l.clip, 11);
+  REQUIRE(k11.values.size() == 2);
+  CHECK(k11.values[0] == float(123456 * 1e-3));
+  CHECK(k11.values[1] == float(-654321 * 1e-3));
+  CHECK(keyanim::test::channel_keys(l.clip, 2).values.empty());
+  float v = -1.0f;
+  CHECK(l.clip.sample_channel(2, 7.5f, v) == Status::ok);
+  CHECK(v == 0.0f);
+  CHECK(l.clip.sample_channel(3, 0.0f, v) == Status::ok);
+  CHECK(v == float(123 * 0.1));  // a constant before its key
+  // A channel the clip does not have, or a NaN position: refused, `v` unchanged.
+  CHECK(l.clip.sample_channel(l.clip.channel_count(), 0.0f, v) == Status::invalid_argument);
+  CHECK(l.clip.sample_channel(3, std::nanf(""), v) == Status::invalid_argument);
+  CHECK(v == float(123 * 0.1));
+}
+
+TEST_CASE("the cursor never changes a result") {
+  const EncodedClip e = random_clip(7, 400, 10);
+  const Clip clip = keyanim::offline::to_clip(e);
+  const Clip other = keyanim::offline::to_clip(random_clip(8, 50, 2));
+  const uint32_t n = clip.channel_count();
+  std::vector<float> a(n), b(n), o(other.channel_count());
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  CHECK(cursor.prepared_for(clip));
+  CHECK(!cursor.prepared_for(other));
+  uint64_t s = 99, mismatches = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // Forward steps, backward jumps, far jumps; a second clip refuses the cursor.
+    double x = i < 1000 ? i * 0.37 : i < 2000 ? 400.0 - (i - 1000) * 0.41 : double(lcg(s) % 40000) / 97.0;
+    if (i % 500 == 0) REQUIRE(other.sample(x, o, &cursor) == Status::invalid_argument);
+    if (i == 2500) REQUIRE(cursor.prepare(clip) == Status::ok);  // a fresh state mid-way
+    REQUIRE(clip.sample(x, a) == Status::ok);
+    REQUIRE(clip.sample(x, b, &cursor) == Status::ok);
+    for (uint32_t c = 0; c < n; ++c) mismatches += !same_bits(a[c], b[c]);
+  }
+  CHECK(mismatches == 0);
+  // A copy of the clip shares its image, and the cursor.
+  const Clip copy = clip;
+  CHECK(cursor.prepared_for(copy));
+  // An unprepared cursor is refused, and a new clip at the address of a destroyed one is a
+  // different clip for the cursor.
+  keyanim::Cursor none;
+  CHECK(clip.sample(1.0, a, &none) == Status::invalid_argument);
+  std::optional<Clip> slot;
+  slot.emplace(keyanim::offline::to_clip(random_clip(21, 300, 4)));
+  std::vector<float> x(slot->channel_count()), y(slot->channel_count());
+  keyanim::Cursor reused;
+  REQUIRE(reused.prepare(*slot) == Status::ok);
+  REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
+  slot.emplace(keyanim::offline::to_clip(random_clip(22, 300, 4)));
+  REQUIRE(slot->channel_count() == x.size());
+  CHECK(slot->sample(150.5, x, &reused) == Status::invalid_argument);
+  REQUIRE(reused.prepare(*slot) == Status::ok);
+  REQUIRE(slot->sample(150.5, x, &reused) == Status::ok);
+  REQUIRE(slot->sample(150.5, y) == Status::ok);
+  for (size_t c = 0; c < x.size(); ++c) CHECK(same_bits(x[c], y[c]));
+}
+
+TEST_CASE("sample_time sample_channels and argument errors") {
+  const Clip clip = keyanim::offline::to_clip(vector_rules());
+  std::vector<float> all(clip.channel_count()), some(3);
+  REQUIRE(clip.sample(7.25, all) == Status::ok);
+  const uint32_t pick[3] = {9, 0, 5};
+  REQUIRE(clip.sample_channels(7.25, pick, some) == Status::ok);
+  CHECK(same_bits(some[0], all[9]));
+  CHECK(same_bits(some[1], all[0]));
+  CHECK(same_bits(some[2], all[5]));
+  float one = 0.0f;
+  REQUIRE(clip.sample_channel(5, 7.25f, one) == Status::ok);
+  CHECK(same_bits(one, all[5]));
+  std::vector<float> t(clip.channel_count());
+  REQUIRE(clip.sample_time(7.0 / 30.0, t) == Status::ok);  // frame 7 at 30 fps
+  REQUIRE(clip.sample(7.0 / 30.0 / (1.0 / 30.0), all) == Status::ok);
+  for (uint32_t c = 0; c < clip.channel_count(); ++c) CHECK(same_bits(t[c], all[c]));
+  CHECK(clip.duration() == 19.0 / 30.0);
+  CHECK(clip.sample(std::nan(""), all) == Status::invalid_argument);
+  CHECK(clip.sample_time(std::nan(""), all) == Status::invalid_argument);
+  std::vector<float> short_out(clip.channel_count() - 1);
+  CHECK(clip.sample(1.0, short_out) == Status::output_too_small);
+  const uint32_t bad[1] = {12};
+  CHECK(clip.sample_channels(1.0, bad, some) == Status::invalid_argument);
+  CHECK(clip.sample_channels(1.0, pick, std::span<float>(some.data(), 2)) == Status::output_too_small);
+  // A single-frame clip with Frame_Time 0 samples its only frame at any time.
+  const Clip single = keyanim::offline::to_clip(vector_single());
+  std::vector<float> s3(3);
+  REQUIRE(single.sample_time(5.0, s3) == Status::ok);
+  CHECK(s3[0] == float(95250 * 0.001));
+  CHECK(single.duration() == 0.0);
+}
+
+TEST_CASE("a loaded clip holds its keys bit-packed, not expanded") {
+  for (uint64_t seed : {11u, 12u, 13u}) {
+    const EncodedClip e = random_clip(seed, 2000, 12);
+    const Clip clip = keyanim::offline::to_clip(e);
+    // Each key costs its value's bits in at most two records (its block's, and as context of
+    // a neighbouring block), plus per-record headers; expanded arrays cost 8 bytes a key.
+    uint64_t value_bits = 0;
+    for (const auto& ch : e.channels) {
+      if (ch.q.size() < 2) continue;
+      const auto [lo, hi] = std::minmax_element(ch.q.begin(), ch.q.end());
+      value_bits += 3 * ch.q.size() * std::bit_width(uint64_t(*hi - *lo));
+    }
+    const size_t records = e.channels.size() * ((e.frame_count + 63) / 64);
+    CHECK(clip.memory_bytes() <= value_bits / 8 + records * 40 + 16384);
+    CHECK(clip.memory_bytes() < clip.total_keys() * 8);
+  }
+}
+
+TEST_CASE("the writer refuses clips that break the spec") {
+  auto bad = [](auto mutate) {
+    EncodedClip e = vector_rules();
+    mutate(e);
+    CHECK_THROWS_AS(keyanim::offline::validate_encoded_clip(e), keyanim::offline::Error);
+    CHECK_THROWS_AS(keyanim::offline::write_kanim(e), keyanim::offline::Error);
+  };
+  bad([](EncodedClip& e) { e.channels[0].frames = {0, 3, 3, 10, 19}; });
+  bad([](EncodedClip& e) { e.channels[0].frames.back() = 20; });
+  bad([](EncodedClip& e) { e.channels[0].step = std::numeric_limits<double>::infinity(); });
+  bad([](EncodedClip& e) { e.channels[0].step = 0.0; });
+  bad([](EncodedClip& e) { e.channels[0].tension = 1.5f; });
+  bad([](EncodedClip& e) { e.channels[0].q[0] = (int64_t(1) << 53) + 1; });
+  bad([](EncodedClip& e) { e.channels[0].q.pop_back(); });
+  bad([](EncodedClip& e) { e.channels[0].step = 1e300; });  // value overflows binary32
+  bad([](EncodedClip& e) { e.channels.pop_back(); });
+  bad([](EncodedClip& e) { e.skeleton.joints[1].parent = 1; });
+  bad([](EncodedClip& e) { e.skeleton.joints[2].channels = {CT::x_rotation}; e.channels.push_back({}); });
+  bad([](EncodedClip& e) { e.frame_time = 0.0; });
+  bad([](EncodedClip& e) { e.frame_time = std::nan(""); });
+}
+
+}  // TEST_SUITE("container")
