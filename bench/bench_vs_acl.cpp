@@ -150,6 +150,7 @@ std::vector<CorpusClip> find_clips(const fs::path& corpus, const std::string& fi
   for (const auto& [dir, group, fps] : {std::tuple{"cmu", "cmu120", 120.0}, {"bandai", "bandai30", 30.0}}) {
     std::vector<fs::path> files;
     std::error_code ec;
+    if (!fs::is_directory(corpus / dir)) continue;  // a corpus without this group
     for (const auto& e : fs::directory_iterator(corpus / dir, ec))
       if (e.path().extension() == ".bvh" && e.path().filename().string().find(filter) != std::string::npos)
         files.push_back(e.path());
@@ -691,7 +692,7 @@ json summarize(const json& clips) {
     std::vector<const json*> in;
     for (const json& c : clips)
       if (c["group"] == g) in.push_back(&c);
-    out["clips"] = in.size();
+    out["clip_count"] = in.size();
     if (in.empty()) {
       groups[g] = out;
       continue;
