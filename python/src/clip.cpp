@@ -138,7 +138,12 @@ void register_clip(py::module_& m) {
   cls.def_property_readonly("channel_count", [](const PyClip& c) { return c.clip.channel_count(); }, "Values per frame.");
   cls.def_property_readonly("total_keys", [](const PyClip& c) { return c.clip.total_keys(); }, "Keys over every channel.");
   cls.def_property_readonly("memory_bytes", [](const PyClip& c) { return c.clip.memory_bytes(); },
-                            "Bytes the loaded clip holds in memory.");
+                            "Bytes the loaded clip holds in memory: skeleton_bytes + animation_bytes.");
+  cls.def_property_readonly("skeleton_bytes", [](const PyClip& c) { return c.clip.skeleton_bytes(); },
+                            "Bytes of the rig (names, parents, offsets, channel lists, pose tables): the same "
+                            "for every clip of one skeleton.");
+  cls.def_property_readonly("animation_bytes", [](const PyClip& c) { return c.clip.animation_bytes(); },
+                            "Bytes of the clip's own motion (keys, records, per-channel facts, notes).");
   cls.def_property_readonly("encoder_notes", [](const PyClip& c) { return text(c.clip.encoder_notes()); },
                             "The encoder's key=value notes stored in the file (settings, error reached).");
   cls.def_property_readonly(

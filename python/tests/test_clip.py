@@ -66,6 +66,13 @@ def test_load_from_path_and_bytes(keyanim, walk_encoded, tmp_path):
     assert clips[0].frame_time == 0.0083333 and clips[0].duration == pytest.approx(343 * 0.0083333)
     assert "tolerance_units" in clips[0].encoder_notes
     assert clips[0].memory_bytes > 0
+    # The rig's part and the animation's part, apart; info says the same.
+    c = clips[0]
+    assert c.skeleton_bytes > 0 and c.animation_bytes > 0
+    assert c.skeleton_bytes + c.animation_bytes == c.memory_bytes
+    assert (c.info["skeleton_bytes"], c.info["animation_bytes"]) == (c.skeleton_bytes, c.animation_bytes)
+    # 38 nodes with their names, OFFSETs and channel lists cost more than their names' bytes.
+    assert c.skeleton_bytes > sum(len(n) for n in c.joint_names)
     assert repr(clips[0]).startswith("<keyanim.Clip: 344 frames, 38 nodes, 96 channels")
 
 

@@ -79,8 +79,14 @@ class Clip {
   Status channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<float> values) const noexcept;
   // Informative encoder notes stored in the file (settings, measured error), as key=value text.
   const std::string& encoder_notes() const noexcept;
-  // Bytes held by the clip's image (keys, skeleton, notes, indexes), for memory budgets.
+  // Bytes held by the clip's image (keys, skeleton, notes, indexes), for memory budgets:
+  // skeleton_bytes() + animation_bytes(). The skeleton's part (names, parents, OFFSETs, channel
+  // lists and the pose tables made from them) is the same for every clip of one rig, which an
+  // engine would hold once; the animation's part (keys, records, per-channel facts, notes) is
+  // the clip's own.
   size_t memory_bytes() const noexcept;
+  size_t skeleton_bytes() const noexcept;
+  size_t animation_bytes() const noexcept;
 
   // Every channel at frame position f (fractional frames are in-betweens; clamped to the clip),
   // exactly as spec/FORMAT.md Appendix A computes it, with f rounded to binary32. `out` must

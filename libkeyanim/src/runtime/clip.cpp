@@ -54,6 +54,8 @@ const Skeleton& Clip::skeleton() const noexcept { return KEYANIM_IMG.skeleton; }
 uint64_t Clip::total_keys() const noexcept { return KEYANIM_IMG.total_keys; }
 const std::string& Clip::encoder_notes() const noexcept { return KEYANIM_IMG.notes; }
 size_t Clip::memory_bytes() const noexcept { return image_ ? image_->memory_bytes() : 0; }
+size_t Clip::skeleton_bytes() const noexcept { return image_ ? image_->skeleton_bytes() : 0; }
+size_t Clip::animation_bytes() const noexcept { return image_ ? image_->animation_bytes() : 0; }
 
 double Clip::duration() const noexcept {
   const Image& img = KEYANIM_IMG;

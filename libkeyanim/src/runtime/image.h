@@ -106,7 +106,9 @@ struct Image {
   const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
     return payload.data() + record_offset[size_t(block) * block_curves + curve];
   }
-  size_t memory_bytes() const noexcept;
+  size_t skeleton_bytes() const noexcept;   // the rig's part (image_build.cpp)
+  size_t animation_bytes() const noexcept;  // the rest
+  size_t memory_bytes() const noexcept { return skeleton_bytes() + animation_bytes(); }
 };
 
 // Builds the image of a valid source (its keys decoded, every rule checked).

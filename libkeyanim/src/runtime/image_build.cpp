@@ -123,18 +123,31 @@ void shrink(Image& img) {
   img.notes.shrink_to_fit();
 }
 
-}  // namespace
-
-size_t Image::memory_bytes() const noexcept {
-  size_t n = sizeof(Image) + notes.capacity();
-  n += skeleton.joints.capacity() * sizeof(Joint);
+// The skeleton's nodes: the array, names beyond the small-string buffer, channel lists.
+size_t joints_bytes(const Skeleton& skeleton) noexcept {
+  size_t n = skeleton.joints.capacity() * sizeof(Joint);
   for (const Joint& j : skeleton.joints) {
-    n += j.name.capacity() > 15 ? j.name.capacity() : 0;  // beyond the small-string buffer
+    n += j.name.capacity() > 15 ? j.name.capacity() : 0;
     n += j.channels.capacity() * sizeof(ChannelType);
   }
+  return n;
+}
+
+}  // namespace
+
+// The rig: what every clip of one skeleton holds alike (names, parents, OFFSETs, channel lists,
+// the pose tables built from them). An engine holding many clips of one rig needs it once.
+size_t Image::skeleton_bytes() const noexcept {
+  size_t n = joints_bytes(skeleton);
   n += node_offset.capacity() * sizeof(float) + rot_column.capacity() * sizeof(uint32_t) +
        rot_axis.capacity() + rot_first.capacity() * sizeof(uint32_t) + moves.capacity() * sizeof(Move) +
        move_first.capacity() * sizeof(uint32_t);
+  return n;
+}
+
+// The motion: keys, per-channel and per-curve facts, records, notes, and the image itself.
+size_t Image::animation_bytes() const noexcept {
+  size_t n = sizeof(Image) + notes.capacity();
   n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
   n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
   n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);

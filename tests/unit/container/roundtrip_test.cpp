@@ -175,6 +175,38 @@ TEST_CASE("a loaded clip holds its keys bit-packed, not expanded") {
   }
 }
 
+TEST_CASE("memory is reported as the rig's part and the animation's part") {
+  const EncodedClip e = random_clip(21, 1500, 10);
+  EncodedClip renamed = e;  // the same motion on a rig whose names are longer
+  size_t longer = 0;
+  for (Joint& j : renamed.skeleton.joints) {
+    j.name += std::string(40, 'n');
+    longer += j.name.size();
+  }
+  EncodedClip shorter = e;  // the same rig with a third of the frames (and so fewer keys)
+  shorter.frame_count = 500;
+  for (auto& ch : shorter.channels) {
+    size_t n = 0;
+    while (n < ch.frames.size() && ch.frames[n] < 500) ++n;
+    ch.frames.resize(n), ch.q.resize(n);
+  }
+  const Clip a = load(keyanim::offline::write_kanim(e)).clip;
+  const Clip b = load(keyanim::offline::write_kanim(renamed)).clip;
+  const Clip c = load(keyanim::offline::write_kanim(shorter)).clip;
+  REQUIRE(a.channel_count() > 0);
+  REQUIRE(b.channel_count() > 0);
+  REQUIRE(c.channel_count() > 0);
+  for (const Clip* k : {&a, &b, &c}) CHECK(k->memory_bytes() == k->skeleton_bytes() + k->animation_bytes());
+  // Names are the rig's: they grow its part by at least their bytes and leave the animation's.
+  CHECK(b.animation_bytes() == a.animation_bytes());
+  CHECK(b.skeleton_bytes() >= a.skeleton_bytes() + longer);
+  // Keys are the animation's: fewer of them shrink its part and leave the rig's.
+  CHECK(c.skeleton_bytes() == a.skeleton_bytes());
+  CHECK(c.animation_bytes() < a.animation_bytes());
+  CHECK(a.skeleton_bytes() >= e.skeleton.joints.size() * (sizeof(Joint) + 3 * sizeof(float)));
+  CHECK(Clip{}.memory_bytes() == 0);
+}
+
 TEST_CASE("the writer refuses clips that break the spec") {
   auto bad = [](auto mutate) {
     EncodedClip e = vector_rules();

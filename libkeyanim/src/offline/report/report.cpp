@@ -169,6 +169,8 @@ nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& c
   if (curved) j["tension"] = {{"min", t_min}, {"mean", t_sum / curved}, {"max", t_max}};
   j["raw_f32_bytes"] = uint64_t(4) * clip.frame_count() * clip.channel_count();
   j["memory_bytes"] = clip.memory_bytes();
+  j["skeleton_bytes"] = clip.skeleton_bytes();  // once per rig in an engine
+  j["animation_bytes"] = clip.animation_bytes();
   j["encoder_notes"] = clip.encoder_notes();
   if (nlohmann::json noted = guarantee_json(clip.encoder_notes()); !noted.empty()) j["guarantee"] = noted;
   return j;
