@@ -269,6 +269,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src) {
       last = std::max(last, first);
       while (last < keys.n && int64_t(keys.k[last]) < start + kBlockFrames) ++last;
       plans[size_t(b) * nb + i] = plan_record(keys, first, last, start, cv.q_base, cv.base_bits);
+      first = last;  // the next block's keys start where this block's end
     }
   }
   // Offsets in block-major order; u32 offsets bound the payload (checked: 2^32 bytes is far

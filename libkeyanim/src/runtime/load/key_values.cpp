@@ -99,6 +99,61 @@ Status Loader::residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i,
   return Status::ok;
 }
 
+namespace {
+
+// Where decoding one channel's keys stopped: n when every key was in bounds, else the key and
+// the bound it broke.
+struct KeysDecoded {
+  uint32_t at;
+  bool residual_too_big;  // else |q| > 2^53
+  int64_t lo, hi;         // the smallest and largest q decoded
+};
+
+// Residual i of a channel with B residual bytes, byte k in plane[k].
+template <uint32_t B>
+[[gnu::always_inline]] inline uint64_t residual(const uint8_t* const* plane, uint32_t i) noexcept {
+  uint64_t v = 0;
+  for (uint32_t k = 0; k < B; ++k) v |= uint64_t(plane[k][i]) << (8 * k);
+  return v;
+}
+
+// q_i = prediction + residual for one channel of n keys (section 4.5), into out. One loop per
+// width and coding, so that the loop body has no branch but the bounds: below 8 bytes a residual
+// is below 2^56 and cannot break the 2^57 bound, and delta coding predicts q_{i-1} (0 for the
+// first key, which q = 0 gives).
+template <uint32_t B>
+KeysDecoded decode_keys(const uint8_t* const* plane, ValueCoding coding, const uint32_t* kf, uint32_t n,
+                        int64_t* out) noexcept {
+  KeysDecoded r{n, false, INT64_MAX, INT64_MIN};
+  int64_t q = 0, q_prev = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint64_t v = residual<B>(plane, i);
+    if constexpr (B == kMaxResidualBytes) {
+      if ((v >> 1) + (v & 1) > kMaxAbsResidual) [[unlikely]] {  // |r| = (v + 1) / 2 without overflow
+        r.at = i, r.residual_too_big = true;
+        return r;
+      }
+    }
+    const int64_t predicted = coding == ValueCoding::delta ? q : predict_q(coding, kf, i, q, q_prev);
+    q_prev = q;
+    q = predicted + zigzag_decode(v);  // |prediction + r| < 2^58 after the bound above
+    if (q > kMaxAbsQ || q < -kMaxAbsQ) [[unlikely]] {
+      r.at = i;
+      return r;
+    }
+    out[i] = q;
+    r.lo = std::min(r.lo, q), r.hi = std::max(r.hi, q);
+  }
+  return r;
+}
+
+using DecodeKeys = KeysDecoded (*)(const uint8_t* const*, ValueCoding, const uint32_t*, uint32_t, int64_t*) noexcept;
+constexpr DecodeKeys kDecodeKeys[kMaxResidualBytes + 1] = {decode_keys<0>, decode_keys<1>, decode_keys<2>,
+                                                           decode_keys<3>, decode_keys<4>, decode_keys<5>,
+                                                           decode_keys<6>, decode_keys<7>, decode_keys<8>};
+
+}  // namespace
+
 Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
   // Plane k: byte k of every residual of the channels with Residual_Bytes > k (section 4.5).
   const size_t channels = parts.channels.size();
@@ -115,27 +170,15 @@ Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
   for (size_t ch = 0; ch < channels; ++ch) {
     const internal::SourceChannel& t = parts.channels[ch];
     const uint32_t bytes = residual_bytes_[ch];
-    const uint8_t* plane[internal::kMaxResidualBytes];
+    const uint8_t* plane[internal::kMaxResidualBytes] = {};
     for (uint32_t k = 0; k < bytes; ++k) plane[k] = c.data + at[k], at[k] += t.key_count;
     const uint32_t* kf = parts.frames.data() + t.first_key;  // KTIM is parsed before KVAL
-    int64_t* out = parts.q.data() + t.first_key;
-    int64_t q = 0, q_prev = 0, lo = 0, hi = 0;
-    for (uint32_t i = 0; i < t.key_count; ++i) {
-      uint64_t v = 0;
-      for (uint32_t k = 0; k < bytes; ++k) v |= uint64_t(plane[k][i]) << (8 * k);
-      // |r| = (v + 1) / 2 without overflow; after this check |prediction + r| < 2^58.
-      if ((v >> 1) + (v & 1) > internal::kMaxAbsResidual) [[unlikely]]
-        return fail_in(Status::corrupt, c, plane[0] + i - c.data, "channel " + std::to_string(ch) + ": a residual beyond 2^57");
-      const int64_t predicted = internal::predict_q(codings_[ch], kf, i, q, q_prev);
-      q_prev = q;
-      q = predicted + internal::zigzag_decode(v);
-      if (q > internal::kMaxAbsQ || q < -internal::kMaxAbsQ) [[unlikely]]
-        return fail_in(Status::corrupt, c, plane[0] + i - c.data, "channel " + std::to_string(ch) + ": |q| > 2^53");
-      out[i] = q;
-      lo = i ? std::min(lo, q) : q, hi = i ? std::max(hi, q) : q;
-    }
+    const KeysDecoded r = kDecodeKeys[bytes](plane, codings_[ch], kf, t.key_count, parts.q.data() + t.first_key);
+    if (r.at < t.key_count) [[unlikely]]
+      return fail_in(Status::corrupt, c, plane[0] + r.at - c.data,
+                     "channel " + std::to_string(ch) + (r.residual_too_big ? ": a residual beyond 2^57" : ": |q| > 2^53"));
     // q x step is monotone in q, so the extremes tell whether every value is finite.
-    if (t.key_count && (!std::isfinite(dequantize(lo, t.step)) || !std::isfinite(dequantize(hi, t.step))))
+    if (t.key_count && (!std::isfinite(dequantize(r.lo, t.step)) || !std::isfinite(dequantize(r.hi, t.step))))
       return fail_in(Status::corrupt, c, bytes ? plane[0] - c.data : 0,
                      "channel " + std::to_string(ch) + ": a key value is not finite");
   }
