@@ -105,7 +105,7 @@ class Dataset:
             return clip.frame_count
         if not clip.frame_time > 0:
             raise Error("%s: the clip has no frame time; cannot sample it at %g fps" % (path, self.fps))
-        return int(math.floor((clip.frame_count - 1) * clip.frame_time * self.fps + 1e-6)) + 1
+        return clip.frame_count_at(self.fps)
 
     def _windows_in(self, clip, path):
         frames = self._frames_at_rate(clip, path)
@@ -131,11 +131,7 @@ class Dataset:
         """The source frame positions (float64) that window `index` samples."""
         c, first = self.locate(index)
         clip = self.clips[c]
-        frames = np.arange(first, first + self.window, dtype=np.float64)
-        if self.fps is None or clip.frame_count <= 1:
-            return np.minimum(frames, max(clip.frame_count - 1, 0))
-        # As decode.cpp: (i / fps) / frame_time, never accumulated; the 1e-6 slack may overshoot.
-        return np.minimum((frames / self.fps) / clip.frame_time, clip.frame_count - 1)
+        return clip.frame_positions_at(self.fps, np.arange(first, first + self.window, dtype=np.int64))
 
     def __getitem__(self, index):
         c, _ = self.locate(index)

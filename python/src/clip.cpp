@@ -13,6 +13,16 @@
 namespace keyanim::python {
 namespace {
 
+// A frame rate given to a Clip method: a finite number > 0, and a clip with a frame time.
+double rate_arg(const PyClip& c, const py::object& fps) {
+  const double r = fps.cast<double>();
+  if (!(r > 0.0) || !std::isfinite(r))
+    throw offline::Error(offline::ErrorKind::invalid_argument, "fps must be a finite number > 0");
+  if (!(c.clip.frame_time() > 0.0))
+    throw offline::Error(offline::ErrorKind::invalid_argument, "the clip has no frame time; cannot sample it at a rate");
+  return r;
+}
+
 // The whole file, or Error::io with errno; Error (limit) past the loader's size limit.
 std::vector<uint8_t> read_file(const std::string& path, uint64_t max_bytes) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
@@ -219,6 +229,36 @@ void register_clip(py::module_& m) {
       py::arg("channel"),
       "The keys of one channel (index into channel_names): frames (uint32) and values (float32),\n"
       "exactly as the sampler uses them. No keys: the channel is 0 throughout; one: constant.");
+  cls.def(
+      "frame_count_at",
+      [](const PyClip& c, const py::object& fps) -> uint64_t {
+        if (fps.is_none() || c.clip.frame_count() <= 1) return c.clip.frame_count();
+        return offline::rate_map(c.clip.frame_count() - 1, c.clip.frame_time(), rate_arg(c, fps)).count;
+      },
+      py::arg("fps") = py::none(),
+      "How many frames to_motion(fps) makes: frame_count for fps=None; otherwise decode.h's rule\n"
+      "(a rate within 0.01% of a multiple or divisor of the clip's own gives its frames, their\n"
+      "in-betweens or every M-th of them; any other, frames every 1/fps s up to the end).");
+  cls.def(
+      "frame_positions_at",
+      [](const PyClip& c, const py::object& fps, const py::array_t<int64_t, py::array::forcecast>& frames) {
+        py::array_t<double> out(frames.request().shape);
+        const int64_t* in = frames.data();
+        double* o = out.mutable_data();
+        const uint32_t n = c.clip.frame_count();
+        const double last = n ? double(n - 1) : 0.0;
+        if (fps.is_none() || n <= 1) {
+          for (py::ssize_t i = 0; i < frames.size(); ++i) o[i] = std::clamp(double(in[i]), 0.0, last);
+          return out;
+        }
+        const offline::RateMap rate = offline::rate_map(n - 1, c.clip.frame_time(), rate_arg(c, fps));
+        for (py::ssize_t i = 0; i < frames.size(); ++i)
+          o[i] = in[i] < 0 ? 0.0 : std::min(rate.position(uint64_t(in[i])), last);  // clamped to the clip
+        return out;
+      },
+      py::arg("fps"), py::arg("frames"),
+      "Source frame positions (float64, frames.shape) of output frames `frames` of\n"
+      "to_motion(fps), clamped to the clip: what Dataset samples at a rate.");
   cls.def(
       "to_motion",
       [](const PyClip& c, const py::object& fps) {

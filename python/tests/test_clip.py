@@ -178,6 +178,28 @@ def test_to_motion(keyanim, walk_clip, walk_encoded, tmp_path):
         assert info.value.kind == "invalid_argument"
 
 
+def test_a_rate_within_rounding_of_the_clips_own(keyanim, walk_clip):
+    # The walk stores Frame Time .0083333, a hair under 1/120 s: 120 fps is its own rate.
+    source = walk_clip.to_motion()
+    m120 = walk_clip.to_motion(fps=120)
+    assert m120.frame_count == 344 == walk_clip.frame_count_at(120)
+    assert np.array_equal(m120.channels, source.channels)
+    # 240 fps: the source frames and one in-between each, at exact half frames.
+    m240 = walk_clip.to_motion(fps=240)
+    assert m240.frame_count == 687 == walk_clip.frame_count_at(240)
+    assert np.array_equal(m240.channels, walk_clip.sample_frames(np.arange(687) / 2).astype(np.float64))
+    # 40 fps: every third source frame; 119 fps: frames every 1/119 s up to the end.
+    assert np.array_equal(walk_clip.frame_positions_at(40, [0, 1, 114]), [0.0, 3.0, 342.0])
+    assert walk_clip.frame_count_at(40) == 115
+    assert walk_clip.frame_count_at(119) == int(np.floor(343 * 0.0083333 * 119 + 1e-6)) + 1
+    assert walk_clip.frame_positions_at(119, [7])[0] == (7 / 119) / 0.0083333
+    assert walk_clip.frame_count_at() == 344
+    assert np.array_equal(walk_clip.frame_positions_at(None, [-3, 5, 999]), [0.0, 5.0, 343.0])
+    for bad in (0, -1, float("nan"), float("inf")):
+        with pytest.raises(keyanim.Error):
+            walk_clip.frame_count_at(bad)
+
+
 def test_from_motion_keeps_every_frame(keyanim, walk, tmp_path):
     clip = keyanim.Clip.from_motion(walk)
     assert clip.total_keys == 344 * 96 - 20 * 344  # zero channels need no keys

@@ -65,6 +65,14 @@ def test_windows_at_another_rate(keyanim, library):
         assert np.array_equal(ds[i].astype(np.float64), rows[first:first + 16])
 
 
+def test_windows_at_the_clips_own_rate(keyanim, library):
+    # 120 fps on clips that store Frame Time .0083333: the same windows as the source rate.
+    at_rate, own = keyanim.Dataset(library, fps=120, window=16), keyanim.Dataset(library, window=16)
+    assert len(at_rate) == len(own)
+    for i in (0, len(own) // 2, len(own) - 1):
+        assert np.array_equal(at_rate[i], own[i])
+
+
 def test_outputs(keyanim, library):
     ds = keyanim.Dataset(library, window=10, output=("channels", "local_quaternions", "local_translations",
                                                       "world_positions"))

@@ -86,6 +86,33 @@ tween)
   [ "$("$K" info part.bvh --json | json 'd["frames"]')" = "10" ] || die "--frames count"
   expect_rc 1 "$K" decode w.kanim -o x.bvh --fps 30 --inbetweens 2
   expect_rc 1 "$K" decode w.kanim -o x.bvh --frames 5:400
+  # The walk stores Frame Time .0083333, a hair under 1/120 s: --fps 120 is the clip's own rate
+  # and gives its 344 frames, the same values as the source-rate decode (MOTION lines but the
+  # Frame Time); --fps 240 gives the in-betweens of --inbetweens 1, value for value.
+  expect_rc 0 "$K" decode w.kanim -o w.bvh
+  expect_rc 0 "$K" decode w.kanim -o w120.bvh --fps 120
+  [ "$("$K" info w120.bvh --json | json 'd["frames"]')" = "344" ] || die "--fps 120 dropped a frame"
+  cmp -s <(sed -n '/^MOTION/,$p' w.bvh | grep -v 'Frame Time') <(sed -n '/^MOTION/,$p' w120.bvh | grep -v 'Frame Time') ||
+    die "--fps 120 values differ from the source frames"
+  expect_rc 0 "$K" decode w.kanim -o w240.bvh --fps 240
+  cmp -s <(sed -n '/^MOTION/,$p' w2.bvh | grep -v 'Frame Time') <(sed -n '/^MOTION/,$p' w240.bvh | grep -v 'Frame Time') ||
+    die "--fps 240 differs from --inbetweens 1"
+  ;;
+positions)
+  # A frame or time the clip does not have is exit 1 (README's exit table), as render does.
+  "$K" encode "$WALK" -o w.kanim 2>/dev/null
+  for bad in "--frame 1000" "--frame 344" "--frame -1" "--frame -0.5" "--time 100" "--time -0.1"; do
+    expect_rc 1 "$K" sample w.kanim $bad
+  done
+  "$K" sample w.kanim --frame 1000 2>err >/dev/null
+  grep -q 'frames 0 to 343' err || die "the refusal does not say the clip's range: $(cat err)"
+  for good in "--frame 0" "--frame 343" "--frame 342.5" "--time 0" "--time 1.5"; do
+    expect_rc 0 "$K" sample w.kanim $good
+  done
+  # The last frame's time, as info gives the duration, is in the clip.
+  d=$("$K" info w.kanim --json | json '(d["frames"] - 1) * d["frame_time"]')
+  expect_rc 0 "$K" sample w.kanim --time "$d"
+  expect_rc 1 "$K" render w.kanim --frame 1000 -o r.svg
   ;;
 directory)
   mkdir -p in/sub; cp "$WALK" in/a.bvh; cp "$WALK" in/sub/b.bvh; echo garbage >in/broken.bvh

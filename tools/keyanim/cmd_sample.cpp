@@ -14,14 +14,34 @@ const char* const kSampleHelp =
     "usage: keyanim sample IN.kanim (--frame N | --time S) [--joint NAME] [--world]\n"
     "                      [--position-channels replace|add] [--json]\n"
     "One pose, decoded on the fly (fractional frames and times between frames are in-betweens).\n"
-    "  --frame N             frame position, may be fractional (clamped to the clip)\n"
-    "  --time S              time in seconds (frame position = S / frame time; clamped)\n"
+    "  --frame N             frame position, 0 .. frames-1, may be fractional\n"
+    "  --time S              time in seconds, 0 .. the clip's duration (frame position =\n"
+    "                        S / frame time); a frame or time the clip does not have is exit 1\n"
     "  --joint NAME          only this joint (default: all)\n"
     "  --world               world positions by forward kinematics instead of channel values\n"
     "  --position-channels replace|add\n"
     "                        with --world, how position channels below the root combine with\n"
     "                        OFFSET: replace it (Blender; default) or add to it (three.js)\n"
     "  --json                one JSON object on standard output\n";
+
+namespace {
+
+// A frame or time the clip does not have is a usage error (exit 1), as in render: positions are
+// not clamped. A time may exceed the duration by rounding (duration = (frames - 1) frame time).
+void check_position(const std::string& in, const Clip& clip, const char* option, double given, double pos) {
+  const double last = double(clip.frame_count() - 1);
+  if (pos >= 0.0 && (pos <= last || (option[2] == 't' && pos <= last * (1.0 + 1e-12)))) return;
+  char text[200];
+  if (option[2] == 'f')
+    std::snprintf(text, sizeof text, "%s %.9g is not in the clip (it has frames 0 to %u)", option, given,
+                  clip.frame_count() - 1);
+  else
+    std::snprintf(text, sizeof text, "%s %.9g is not in the clip (it has times 0 to %.9g s)", option, given,
+                  clip.duration());
+  fail(kUsage, in + ": " + text);
+}
+
+}  // namespace
 
 int cmd_sample(const Argv& argv, Globals& g) {
   const Args args(argv, {"--frame", "--time", "--joint", "--position-channels"}, {"--world", "--json"});
@@ -36,6 +56,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   if (clip.frame_count() == 0) fail(kBadInput, in + ": the clip has no frames to sample");
   if (args.has("--time") && !(clip.frame_time() > 0.0)) fail(kBadInput, in + ": the clip has no frame time; use --frame");
   const double pos = args.has("--frame") ? frame : time / clip.frame_time();
+  check_position(in, clip, args.has("--frame") ? "--frame" : "--time", args.has("--frame") ? frame : time, pos);
   std::vector<float> row(clip.channel_count());
   if (const Status s = clip.sample(pos, row); s != Status::ok) fail(kUsage, std::string("cannot sample: ") + status_string(s));
 

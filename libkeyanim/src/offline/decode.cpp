@@ -1,14 +1,5 @@
-// Rebuilding frames from a clip: the source frames, another frame rate, or in-betweens.
-//
-// Output frame i lies at source frame position
-//   source rate:   first + i                         i = 0 .. last - first
-//   inbetweens N:  first + i / (N + 1)               i = 0 .. (last - first) (N + 1)
-//   fps:           first + (i / fps) / frame_time    i = 0 .. floor(D fps + 1e-6)
-// where D = (last - first) frame_time is the range's duration in seconds: the last output frame
-// is the last one at or before the range's end, and the end itself is included when it falls
-// within a millionth of an output frame of a frame time (so 30 fps from 120 fps source lands on
-// every 4th frame despite rounding). Positions are computed from i by one multiplication or
-// division, never accumulated.
+// Rebuilding frames from a clip: the source frames, another frame rate, or in-betweens, by the
+// rules of decode.h (RateMap for a rate).
 #include <cmath>
 #include <new>
 #include <string>
@@ -18,6 +9,28 @@
 #include "keyanim/offline/decode.h"
 
 namespace keyanim::offline {
+
+RateMap rate_map(uint64_t span, double frame_time, double fps) noexcept {
+  RateMap m;
+  m.fps = fps, m.frame_time = frame_time;
+  if (span == 0) {  // one frame, whatever the frame time (it may be 0)
+    m.count = 1, m.per = 1;
+    return m;
+  }
+  const double r = fps * frame_time;  // output frames per source frame
+  const double n = std::round(r), k = std::round(1.0 / r);
+  if (n >= 1.0 && n <= 4294967295.0 && std::fabs(r - n) <= kRateSnap * r) {
+    m.per = static_cast<uint32_t>(n);
+    m.count = span <= UINT64_MAX / m.per - 1 ? span * m.per + 1 : UINT64_MAX;
+  } else if (k >= 2.0 && k <= 4294967295.0 && std::fabs(1.0 / r - k) <= kRateSnap / r) {
+    m.every = static_cast<uint32_t>(k);
+    m.count = span / m.every + 1;
+  } else {
+    const double c = std::floor(static_cast<double>(span) * frame_time * fps + 1e-6);
+    m.count = c < 1.8e19 ? static_cast<uint64_t>(c) + 1 : UINT64_MAX;
+  }
+  return m;
+}
 
 void FrameDecoder::start(const Clip& clip, const ResampleOptions& options) {
   auto invalid = [](const std::string& why) { throw Error(ErrorKind::invalid_argument, why); };
@@ -46,9 +59,8 @@ void FrameDecoder::start(const Clip& clip, const ResampleOptions& options) {
     invalid("first_frame " + std::to_string(first_) + " is after last_frame " + std::to_string(last_));
   const uint64_t span = last_ - first_;
   if (options.fps > 0.0) {
-    // Saturates rather than overflows: the caller compares the count with its own limits.
-    const double n = std::floor(static_cast<double>(span) * clip.frame_time() * options.fps + 1e-6);
-    count_ = n < 1.8e19 ? static_cast<uint64_t>(n) + 1 : UINT64_MAX;
+    rate_ = rate_map(span, clip.frame_time(), options.fps);  // saturates: the caller checks the count
+    count_ = rate_.count;
   } else {
     count_ = span * (uint64_t(options.inbetweens) + 1) + 1;  // < 2^64: both factors < 2^32
   }
@@ -62,7 +74,7 @@ void FrameDecoder::frame(uint64_t i, std::span<double> row) {
   if (options_.fps > 0.0 && span == 0)
     position = first_;  // a single frame, whatever the frame time (it may be 0)
   else if (options_.fps > 0.0)
-    position = first_ + (static_cast<double>(i) / options_.fps) / clip_->frame_time();
+    position = first_ + rate_.position(i);
   else if (options_.inbetweens > 0)
     position = first_ + static_cast<double>(i) / (static_cast<double>(options_.inbetweens) + 1.0);
   else

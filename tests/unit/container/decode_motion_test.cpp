@@ -137,4 +137,56 @@ TEST_CASE("decode_motion at the source rate at another fps with inbetweens and a
   CHECK(m.value(0, 0) == double(float(95250 * 0.001)));
 }
 
+TEST_CASE("a rate within rounding of the clip's own reproduces its frames and in-betweens") {
+  using keyanim::offline::decode_motion;
+  using keyanim::offline::Motion;
+  using keyanim::offline::rate_map;
+  using keyanim::offline::ResampleOptions;
+  // BVH stores Frame Time rounded: .0083333 for 1/120 s, 0.0333333 for 1/30 s.
+  EncodedClip e = vector_long();  // 240 frames
+  e.frame_time = 0.0083333;
+  const Clip clip = keyanim::offline::to_clip(e);
+  const uint32_t C = clip.channel_count();
+  auto same_rows = [&](const Motion& a, uint64_t ra, const Motion& b, uint64_t rb) {
+    for (uint32_t c = 0; c < C; ++c)
+      if (a.value(uint32_t(ra), c) != b.value(uint32_t(rb), c)) return false;
+    return true;
+  };
+  const Motion source = decode_motion(clip);
+  ResampleOptions o;
+  o.fps = 120;  // 239 x 0.0083333 x 120 = 238.999: the old rule's floor made 239 frames, not 240
+  Motion m = decode_motion(clip, o);
+  REQUIRE(m.frame_count == 240);
+  for (uint32_t f : {0u, 1u, 117u, 239u}) CHECK(same_rows(m, f, source, f));
+  o.fps = 240;  // a multiple: the in-betweens, exactly as --inbetweens 1 places them
+  m = decode_motion(clip, o);
+  ResampleOptions ib;
+  ib.inbetweens = 1;
+  const Motion between = decode_motion(clip, ib);
+  REQUIRE(m.frame_count == between.frame_count);
+  CHECK(m.frame_count == 479);
+  for (uint64_t f : {0ull, 1ull, 300ull, 478ull}) CHECK(same_rows(m, f, between, f));
+  o.fps = 40;  // a divisor: every 3rd source frame, the last one (237) included
+  m = decode_motion(clip, o);
+  REQUIRE(m.frame_count == 80);
+  CHECK(same_rows(m, 79, source, 237));
+  o.fps = 119;  // neither: frames every 1/119 s up to the end
+  m = decode_motion(clip, o);
+  CHECK(m.frame_count == uint32_t(std::floor(239 * 0.0083333 * 119 + 1e-6)) + 1);
+  CHECK(m.frame_time == 1.0 / 119.0);
+
+  // The snap is 0.01%: 30 fps against 0.0333333 s snaps, 29.99 does not; 120 against 1/120 s
+  // snaps to the clip's own frames whatever the rounding direction.
+  CHECK(rate_map(194, 0.0333333, 30).per == 1);
+  CHECK(rate_map(194, 0.0333333, 30).count == 195);
+  CHECK(rate_map(194, 0.0333333, 60).per == 2);
+  CHECK(rate_map(194, 0.0333333, 15).every == 2);
+  CHECK(rate_map(194, 0.0333333, 15).count == 98);
+  CHECK(rate_map(194, 0.0333333, 29.99).per == 0);
+  CHECK(rate_map(194, 0.0333333, 29.99).every == 0);
+  CHECK(rate_map(343, 0.00833334, 120).count == 344);
+  CHECK(rate_map(0, 0.0, 30).count == 1);
+  CHECK(rate_map(0, 0.0, 30).position(0) == 0.0);
+}
+
 }  // TEST_SUITE("container")

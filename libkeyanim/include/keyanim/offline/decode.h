@@ -21,12 +21,36 @@ struct ResampleOptions {
 // Output frame i lies at source frame position
 //   source rate:   first + i                           (last - first + 1 frames)
 //   inbetweens N:  first + i / (N + 1)                 ((last - first) (N + 1) + 1 frames)
-//   fps:           first + (i / fps) / frame_time      (floor(D fps + 1e-6) + 1 frames)
-// with D = (last - first) frame_time seconds: frames every 1/fps s from the range's start up
-// to its end, the end included when it lands on an output frame (within 1e-6 of one).
+//   fps:           as RateMap below
 // Values are the clip's float samples as doubles; frame_time becomes frame_time / (N + 1) or
 // 1 / fps. A clip without frames decodes to no frames.
 //
+// The rule for a rate. BVH files store Frame Time rounded (.0083333 for 1/120 s), so a rate
+// asked for is compared with the clip's own first: a rate within 0.01% (kRateSnap) of N times
+// the clip's (N = 1, 2, ...) gives exactly the source frames and their N - 1 in-betweens
+// (positions i / N: --fps 120 on a 120 fps clip reproduces its frames, --fps 240 equals
+// --inbetweens 1), and a rate within 0.01% of the clip's divided by M (M = 2, 3, ...) gives every
+// M-th source frame (positions i M). Any other rate gives frames every 1/fps s from the range's
+// start (positions (i / fps) / frame_time) up to its end D = span frame_time s: floor(D fps +
+// 1e-6) + 1 frames, so the last frame is the last one at or before the end (the end itself
+// when it lands within a millionth of a frame of it). Positions come from i by one
+// multiplication or division, never accumulated.
+inline constexpr double kRateSnap = 1e-4;
+struct RateMap {
+  uint64_t count = 0;  // output frames (saturates at UINT64_MAX rather than overflow)
+  uint32_t per = 0;    // N > 0: N output frames per source frame (a multiple of the clip's rate)
+  uint32_t every = 0;  // M > 0: one output frame every M source frames (a divisor of its rate)
+  double fps = 0.0, frame_time = 0.0;
+  // Output frame i's source frame position, from the range's start.
+  double position(uint64_t i) const noexcept {
+    if (per) return static_cast<double>(i) / per;
+    if (every) return static_cast<double>(i) * every;
+    return (static_cast<double>(i) / fps) / frame_time;
+  }
+};
+// For `span` source frame intervals of `frame_time` s (> 0 when span > 0) at `fps` (> 0).
+RateMap rate_map(uint64_t span, double frame_time, double fps) noexcept;
+
 // FrameDecoder produces those frames one at a time, so that a caller can stream them (e.g. to
 // a BvhWriter) in memory independent of their number, and can see how many there will be
 // before producing any.
@@ -48,6 +72,7 @@ class FrameDecoder {
   uint32_t first_ = 0, last_ = 0;
   uint64_t count_ = 0;
   double frame_time_ = 0.0;
+  RateMap rate_;  // with fps
   std::vector<float> pose_;
   Cursor cursor_;
 };

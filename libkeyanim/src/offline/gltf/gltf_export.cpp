@@ -49,17 +49,18 @@ Window check_options(const Clip& clip, const GltfOptions& o) {
   return w;
 }
 
-// Frame positions and player times of the --fps keys: every 1/fps s from the range's start
-// (as decode_motion resamples), and the range's end.
+// Frame positions and player times of the --fps keys: decode_motion's frames at that rate
+// (decode.h's RateMap), and the range's end.
 void resample_positions(const Window& w, double fps, std::vector<double>& positions, std::vector<double>& times) {
   const double duration = double(w.last - w.first) * w.frame_time;
-  const double count = std::floor(duration * fps + 1e-6) + 1.0;
-  if (!(count <= kMaxResampledKeys))
+  const RateMap rate = rate_map(w.last - w.first, w.frame_time, fps);
+  if (!(double(rate.count) <= kMaxResampledKeys))
     throw Error(ErrorKind::limit, "--fps " + json_number(fps) + " over " + json_number(duration) + " s makes too many keys");
-  for (uint32_t i = 0; i < uint32_t(count); ++i) {
-    const double t = double(i) / fps;
-    times.push_back(t);
-    positions.push_back(w.frame_time > 0.0 ? double(w.first) + t / w.frame_time : double(w.first));
+  for (uint32_t i = 0; i < uint32_t(rate.count); ++i) {
+    // A rate snapped to the clip's own (or a multiple or divisor) keeps the source timeline, so
+    // that its last key lands on the range's end.
+    times.push_back(rate.per || rate.every ? rate.position(i) * w.frame_time : double(i) / fps);
+    positions.push_back(double(w.first) + rate.position(i));
   }
   // Unlike BVH frames, glTF keys need not be evenly spaced: a last key at the range's end keeps
   // the animation as long as the clip.
