@@ -7,7 +7,9 @@ when a test passed without checking anything, which is how a skip that reports i
 looks, or a doctest case whose name CTest cut at a ';' (its filter then matches nothing): a
 doctest case with no assertion ("assertions: 0"), a node:test file with no passing test
 ("# pass 0"). With --expect-skips (a clone without ../shared), at least one test must be
-skipped.
+skipped; with --skips-match REGEX, every test skipped for want of the corpus (its reason names
+it) must have a name REGEX matches (the README's filter for the quick run, so that its "all but
+the tests over the corpus" is true).
 """
 import re
 import sys
@@ -37,6 +39,12 @@ def main():
         print(f"FAIL: '{name}' passed without checking anything (a skip reported as a pass?)")
     for name in failed:
         print(f"FAIL: '{name}' failed")
+    if "--skips-match" in sys.argv:
+        pattern = re.compile(sys.argv[sys.argv.index("--skips-match") + 1])
+        for name, reason in skipped:
+            if "corpus" in reason.lower() and not pattern.search(name):
+                print(f"FAIL: skipped test '{name}' is not matched by the README's filter '{pattern.pattern}'")
+                failed.append(name)
     if "--expect-skips" in sys.argv and not skipped:
         print("FAIL: no test was skipped, yet the corpus is absent")
         return 1

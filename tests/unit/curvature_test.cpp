@@ -228,7 +228,7 @@ TEST_CASE("keys are sorted unique in range on a long noisy signal") {
         keys.end());
 }
 
-TEST_CASE("shoulder Z rotation of a CMU clip: keys land on turning points") {
+TEST_CASE("corpus clip CMU 01_03: the shoulder Z rotation keys land on turning points") {
   const std::filesystem::path path = keyanim::test::corpus_dir() / "cmu" / "assimp__01_03.bvh";
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
