@@ -113,6 +113,10 @@ positions)
   d=$("$K" info w.kanim --json | json '(d["frames"] - 1) * d["frame_time"]')
   expect_rc 0 "$K" sample w.kanim --time "$d"
   expect_rc 1 "$K" render w.kanim --frame 1000 -o r.svg
+  # Text output lists a joint's channels in the file's order (its CHANNELS line), not sorted.
+  got=$("$K" sample w.kanim --frame 0 --joint Hips | tr ' ' '\n' | sed -n 's/=.*//p' | tr '\n' ' ')
+  want=$(grep -m1 CHANNELS "$WALK" | tr -d '\r' | awk '{for (i = 3; i <= NF; i++) printf "%s ", $i}')
+  [ "$got" = "$want" ] || die "sample lists Hips' channels as '$got', the file as '$want'"
   ;;
 directory)
   mkdir -p in/sub; cp "$WALK" in/a.bvh; cp "$WALK" in/sub/b.bvh; echo garbage >in/broken.bvh

@@ -72,6 +72,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   if (args.has("--world")) offline::world_positions(sk, values.data(), world, reading);
 
   nlohmann::json joints = nlohmann::json::array();
+  std::vector<uint32_t> row_node;  // the node of each entry of joints
   for (uint32_t i = 0; i < sk.joints.size(); ++i) {
     const Joint& j = sk.joints[i];
     if (only >= 0 && int32_t(i) != only) continue;
@@ -83,15 +84,20 @@ int cmd_sample(const Argv& argv, Globals& g) {
       for (size_t k = 0; k < j.channels.size(); ++k) e[channel_name(j.channels[k])] = values[j.first_channel + k];
     }
     joints.push_back(e);
+    row_node.push_back(i);
   }
   if (args.has("--json")) {
     std::cout << json_text({{"file", in}, {"frame_position", pos}, {"time", pos * clip.frame_time()}, {"joints", joints}}) << "\n";
     return kOk;
   }
-  for (const auto& e : joints) {
+  // Text: the channels in the file's order (a JSON object's keys come out sorted).
+  for (size_t r = 0; r < joints.size(); ++r) {
+    const nlohmann::json& e = joints[r];
     std::cout << printable(e["name"].get<std::string>());
-    for (auto it = e.begin(); it != e.end(); ++it)
-      if (it.key() != "name") std::cout << " " << it.key() << "=" << it->dump();
+    if (e.contains("position"))
+      std::cout << " position=" << e["position"].dump();
+    else
+      for (ChannelType t : sk.joints[row_node[r]].channels) std::cout << " " << channel_name(t) << "=" << e[channel_name(t)].dump();
     std::cout << "\n";
   }
   return kOk;
