@@ -98,6 +98,17 @@ tween)
   cmp -s <(sed -n '/^MOTION/,$p' w2.bvh | grep -v 'Frame Time') <(sed -n '/^MOTION/,$p' w240.bvh | grep -v 'Frame Time') ||
     die "--fps 240 differs from --inbetweens 1"
   ;;
+typos)
+  # A mistyped command, option or joint gets the nearest names, and joints point to info.
+  "$K" encod x 2>err; [ $? = 1 ] && grep -q "did you mean 'encode'" err || die "no suggestion for 'encod': $(cat err)"
+  "$K" encode --eror 1 "$WALK" 2>err; [ $? = 1 ] && grep -q "did you mean '--error'" err || die "no suggestion for --eror: $(cat err)"
+  "$K" encode "$WALK" -o w.kanim 2>/dev/null
+  "$K" sample w.kanim --frame 1 --joint LeftHnd 2>err; [ $? = 1 ] || die "a joint the clip lacks is not exit 1"
+  grep -q "did you mean 'LeftHand'" err && grep -q 'keyanim info' err || die "no suggestion for LeftHnd: $(cat err)"
+  "$K" sample w.kanim --frame 1 --joint Zzzzzz 2>err
+  grep -q 'did you mean' err && die "a suggestion for a name near nothing: $(cat err)"
+  grep -q 'keyanim info' err || die "the joint error does not mention keyanim info: $(cat err)"
+  ;;
 positions)
   # A frame or time the clip does not have is exit 1 (README's exit table), as render does.
   "$K" encode "$WALK" -o w.kanim 2>/dev/null

@@ -13,6 +13,7 @@
 #include "escape.h"
 #include "keyanim/offline/bvh.h"
 #include "progress.h"
+#include "suggest.h"
 
 namespace keyanim::cli {
 
@@ -61,7 +62,9 @@ Args::Args(const std::vector<std::string>& argv, const std::set<std::string>& va
     } else if (flags.count(name) && !has_inline) {
       values_[name] = "";
     } else {
-      fail(kUsage, "unknown option '" + a + "'");
+      std::vector<std::string> known(valued.begin(), valued.end());
+      known.insert(known.end(), flags.begin(), flags.end());
+      fail(kUsage, "unknown option '" + a + "'" + did_you_mean(name, known));
     }
   }
 }

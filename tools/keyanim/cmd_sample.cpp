@@ -7,6 +7,7 @@
 #include "io.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/report.h"
+#include "suggest.h"
 
 namespace keyanim::cli {
 
@@ -65,7 +66,7 @@ int cmd_sample(const Argv& argv, Globals& g) {
   if (auto name = args.get("--joint")) {
     for (uint32_t i = 0; i < sk.joints.size() && only < 0; ++i)
       if (sk.joints[i].name == *name && !sk.joints[i].end_site) only = int32_t(i);
-    if (only < 0) fail(kUsage, in + ": no joint named '" + *name + "'");
+    if (only < 0) fail(kUsage, in + ": " + no_joint_message(sk, *name));
   }
   std::vector<double> values(row.begin(), row.end());
   std::vector<offline::Vec3> world;

@@ -9,6 +9,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/report.h"
+#include "suggest.h"
 #include "svg.h"
 
 namespace keyanim::cli {
@@ -57,7 +58,7 @@ std::optional<uint32_t> find_channel(const Skeleton& skeleton, const std::string
     error = "joint '" + joint + "' has no " + channel + " channel (it has: " + (has.empty() ? "none" : has) + ")";
     return std::nullopt;
   }
-  error = "no joint named '" + joint + "'";
+  error = no_joint_message(skeleton, joint);
   return std::nullopt;
 }
 

@@ -12,6 +12,7 @@
 #include "io.h"
 #include "keyanim/version.h"
 #include "settings.h"
+#include "suggest.h"
 
 namespace keyanim::cli {
 namespace {
@@ -74,6 +75,12 @@ const Command* find_command(const std::string& name) {
   return nullptr;
 }
 
+[[noreturn]] void unknown_command(const std::string& name) {
+  std::vector<std::string> names;
+  for (const Command& c : kCommands) names.push_back(c.name);
+  fail(kUsage, "unknown command '" + name + "'" + did_you_mean(name, names));
+}
+
 void print_command_help(const Command& c) {
   std::cout << *c.help;
   if (c.encoder_options != Command::none) std::cout << encoder_options_help(c.encoder_options == Command::all);
@@ -85,7 +92,7 @@ int help_command(const Argv& rest) {
   if (rest.empty()) return print_main_help(), kOk;
   if (rest.size() > 1) fail(kUsage, "help takes at most one command");
   const Command* c = find_command(rest.front());
-  if (!c) fail(kUsage, "unknown command '" + rest.front() + "'");
+  if (!c) unknown_command(rest.front());
   print_command_help(*c);
   return kOk;
 }
@@ -148,7 +155,7 @@ int run(int argc, char** argv) {
   rest.erase(rest.begin());
   if (name == "help") return help_command(help ? Argv{} : rest);
   const Command* c = find_command(name);
-  if (!c) fail(kUsage, "unknown command '" + name + "'");
+  if (!c) unknown_command(name);
   if (help) return print_command_help(*c), kOk;
   return c->run(rest, g);
 }
