@@ -94,6 +94,8 @@ tween)
   [ "$("$K" info w120.bvh --json | json 'd["frames"]')" = "344" ] || die "--fps 120 dropped a frame"
   cmp -s <(sed -n '/^MOTION/,$p' w.bvh | grep -v 'Frame Time') <(sed -n '/^MOTION/,$p' w120.bvh | grep -v 'Frame Time') ||
     die "--fps 120 values differ from the source frames"
+  "$K" decode w.kanim -o one.bvh --frames 5:5 2>err || die "a one-frame decode"
+  grep -q ': 1 frame at' err || die "one frame is not '1 frame': $(cat err)"
   expect_rc 0 "$K" decode w.kanim -o w240.bvh --fps 240
   cmp -s <(sed -n '/^MOTION/,$p' w2.bvh | grep -v 'Frame Time') <(sed -n '/^MOTION/,$p' w240.bvh | grep -v 'Frame Time') ||
     die "--fps 240 differs from --inbetweens 1"

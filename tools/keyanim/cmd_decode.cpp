@@ -82,7 +82,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
   output.commit();
   bar.erase();
   if (g.verbosity > 0 && out != "-")
-    std::cerr << printable(in + " -> " + out) << ": " << decoder.frame_count() << " frames at " << decoder.frame_time() << " s\n";
+    std::cerr << printable(in + " -> " + out) << ": " << count_of(decoder.frame_count(), "frame") << " at " << decoder.frame_time() << " s\n";
   return kOk;
 }
 

@@ -102,7 +102,7 @@ int cmd_render(const Argv& argv, Globals& g) {
     const Skeleton& skeleton = theirs.clip ? theirs.clip->skeleton() : theirs.motion->skeleton;
     if (!same_skeleton(first.skeleton, skeleton)) fail(kBadInput, *against + ": not the same skeleton as " + in);
     if (frame >= theirs.frame_count())
-      fail(kUsage, *against + " has no frame " + std::to_string(frame) + " (" + std::to_string(theirs.frame_count()) + " frames)");
+      fail(kUsage, *against + " has no frame " + std::to_string(frame) + " (" + count_of(theirs.frame_count(), "frame") + ")");
     second = theirs.one_frame(frame);
     series.push_back({&second, name_of(*against)});
     title += " against " + name_of(*against);

@@ -15,6 +15,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "escape.h"
 #include "io.h"
 #include "svg.h"  // escape(): the same escaping serves an HTML attribute
 
@@ -153,7 +154,7 @@ int cmd_view(const Argv& argv, Globals& g) {
     if (!same_hierarchy(m.skeleton, clip.skeleton()))
       fail(kBadInput, orig + ": its hierarchy or channels differ from " + in + "'s");
     if (m.frame_count != clip.frame_count() && g.verbosity > 0)
-      std::cerr << "keyanim: warning: " << orig << " has " << m.frame_count << " frames, " << in << " has "
+      std::cerr << "keyanim: warning: " << orig << " has " << count_of(m.frame_count, "frame") << ", " << in << " has "
                 << clip.frame_count() << "; the page compares the frames both have\n";
     embed += embedded("keyanim-embedded-original", orig, bvh);
   }

@@ -87,4 +87,8 @@ std::string json_text(const nlohmann::json& j) {
   return out;
 }
 
+std::string count_of(uint64_t n, const std::string& word) {
+  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+}
+
 }  // namespace keyanim::cli

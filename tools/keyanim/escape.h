@@ -20,4 +20,7 @@ std::string printable(std::string_view text);
 // written exactly as dump() writes them.
 std::string json_text(const nlohmann::json& j);
 
+// "1 frame", "2 frames": n and the word, plural unless n is 1 ("key" -> "keys").
+std::string count_of(uint64_t n, const std::string& word);
+
 }  // namespace keyanim::cli

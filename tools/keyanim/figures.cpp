@@ -9,6 +9,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/report.h"
+#include "escape.h"
 #include "suggest.h"
 #include "svg.h"
 
@@ -159,7 +160,7 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   doc.title(file_label + " " + spec + ": original and reconstruction" + shown);
   doc.text({84, 22}, file_label + "  " + spec + shown + "  \xE2\x80\x94  keys: " + settings_text(settings, result.tolerance_units),
            attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
-  doc.text({84, 40}, std::to_string(out.channel_keys) + " keys on this channel (" + std::to_string(n) + " frames), " +
+  doc.text({84, 40}, count_of(out.channel_keys, "key") + " on this channel (" + count_of(n, "frame") + "), " +
                          std::to_string(result.total_keys) + " in the clip; max channel error " +
                          short_number(out.max_channel_error) + " " + unit + "; max joint error " +
                          short_number(result.error.max_error) + " file units",
