@@ -85,6 +85,7 @@ export function checkClip(bvh) {
     const result = loader.parse(fs.readFileSync(file), path.basename(file, '.kanim'));
     assert.ok(result.skeleton instanceof THREE.Skeleton && result.clip instanceof THREE.AnimationClip);
     assert.ok(Math.abs(result.clip.duration - (F - 1) * info.frame_time) < 1e-9);
+    assert.equal(result.clip.userData.keyanim.budgetMet, true);
     expectHierarchy(result, bvh);
     const play = player(result);
     const kinds = result.clip.tracks.map((t) => t.ValueTypeName);

@@ -35,6 +35,14 @@ test('without the added keys, in-betweens leave the tolerance', { skip: noCli },
   assert.ok(w.distance > 10 * tolerance, `frame 0.5: ${w.distance} (tolerance ${tolerance})`);
 });
 
+// A budget the keys cannot meet: the refinement stops at 64 key times per source frame and says so.
+test('an unreachable tolerance: key times bounded, budgetMet false', { skip: noCli }, () => {
+  const { file, info } = encode(path.join(sourceDir, DATA_CLIPS[0]));
+  const { keyanim } = new KanimLoader().setTolerance(1e-12).parse(fs.readFileSync(file)).clip.userData;
+  assert.equal(keyanim.budgetMet, false);
+  assert.ok(keyanim.keyTimes > 8 * info.frames && keyanim.keyTimes <= 64 * info.frames, `${keyanim.keyTimes} key times for ${info.frames} frames`);
+});
+
 test('several roots: a Group holds them; positions as sample --world', { skip: noCli }, () => {
   checkClip(path.join(sourceDir, MULTI_ROOT));
   const { file } = encode(path.join(sourceDir, MULTI_ROOT));

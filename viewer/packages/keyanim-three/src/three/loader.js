@@ -86,7 +86,7 @@ export class KanimLoader extends Loader {
     const clip = new AnimationClip(name, duration, buildTracks(kanim, keys, trackNames(bones)));
     clip.userData.keyanim = {
       frameCount: kanim.frameCount, frameTime: kanim.frameTime, keyTimes: keys.keys.length,
-      interpolationBudget: budget, notes: kanim.notes,
+      interpolationBudget: budget, budgetMet: keys.budgetMet, notes: kanim.notes,
     };
     return { skeleton, root, clip, kanim };
   }

@@ -15,6 +15,7 @@ import { samplePose } from '../decoder/sample.js';
 const DEG = Math.PI / 180;
 const AXES = [new Vector3(1, 0, 0), new Vector3(0, 1, 0), new Vector3(0, 0, 1)];
 const MAX_DEPTH = 10;        // at most 2^10 - 1 keys added inside one interval of the grid
+const MAX_ADDED = 63;        // and at most 63 per key of the grid in all: memory stays bounded
 const MAX_GRID = 2 ** 24;    // keys of a caller's rate: as many as a clip may have frames
 
 // Frame positions of the keys before refinement: every source frame, or with `fps` the times
@@ -171,19 +172,23 @@ class Sampler {
   // Keys strictly between A and B, in order, so that the chord between neighbours stays
   // within `budget` at the check points.
   refine(A, B, budget, out, depth = 0) {
-    if (depth >= MAX_DEPTH) return;
     const points = Sampler.checkPoints(A.x, B.x);
     if (!points.some((x) => this.chordError(A, B, x) > budget)) return;
+    if (depth >= MAX_DEPTH || this.added >= this.maxAdded) { this.budgetMet = false; return; }
     const M = this.keyAt(Sampler.splitPoint(A.x, B.x));
+    ++this.added;
     this.refine(A, M, budget, out, depth + 1);
     out.push(M);
     this.refine(M, B, budget, out, depth + 1);
   }
 }
 
-// The keys of the clip on `grid`, refined to `budget` (Infinity: the grid alone).
+// The keys of the clip on `grid`, refined to `budget` (Infinity: the grid alone). budgetMet is
+// false where the refinement stopped short: MAX_DEPTH in an interval, or MAX_ADDED x the grid's
+// keys in all (the corpus needs at most 7 x).
 export function sampleKeys(clip, grid, budget) {
   const sampler = new Sampler(clip), keys = [];
+  Object.assign(sampler, { added: 0, maxAdded: MAX_ADDED * grid.length, budgetMet: true });
   let prev = null;
   for (const x of grid) {
     const key = sampler.keyAt(x);
@@ -191,7 +196,7 @@ export function sampleKeys(clip, grid, budget) {
     keys.push(key);
     prev = key;
   }
-  return { keys, rotated: sampler.rotated, moved: sampler.moved };
+  return { keys, rotated: sampler.rotated, moved: sampler.moved, budgetMet: sampler.budgetMet };
 }
 
 // q and -q are the same rotation; neighbouring keys on the same side keep any interpolation
