@@ -84,6 +84,7 @@ export class KanimLoader extends Loader {
     const keys = sampleKeys(kanim, frameGrid(kanim, this.frameRate), budget);
     const duration = Math.max(0, kanim.frameCount - 1) * kanim.frameTime;
     const clip = new AnimationClip(name, duration, buildTracks(kanim, keys, trackNames(bones)));
+    clip.userData ??= {};  // three.js before r161 has no AnimationClip.userData
     clip.userData.keyanim = {
       frameCount: kanim.frameCount, frameTime: kanim.frameTime, keyTimes: keys.keys.length,
       interpolationBudget: budget, budgetMet: keys.budgetMet, notes: kanim.notes,
