@@ -1,9 +1,10 @@
 // The page: opening files (picker, drag and drop, embedded by `keyanim view`), playback, and
-// the panels. Decoding is kanim.js/sample.js; drawing is view3d.js and curves.js.
-import { decodeKanim, looksLikeKanim, nodeLabel } from './kanim.js';
-import { samplePose } from './sample.js';
+// the panels. Decoding is the keyanim-three package's (packages/keyanim-three/src/decoder/);
+// drawing is view3d.js and curves.js.
+import { decodeKanim, looksLikeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
+import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { parseBvh } from './bvh.js';
-import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from './pose.js';
+import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from 'keyanim-three/decoder/pose.js';
 import { View3D } from './view3d.js';
 import { CurvePanel } from './curves.js';
 import { clipFacts, noteLines } from './facts.js';

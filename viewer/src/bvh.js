@@ -2,7 +2,7 @@
 // channels as spec channel type numbers, firstChannel) and the motion as one Float64Array of
 // frames x channels. Conventions as spec/FORMAT.md Appendix B: nodes in file order, End Sites
 // as nodes, channels numbered in node order. Errors name line and column.
-import { CHANNEL_TYPES } from './kanim.js';
+import { CHANNEL_TYPES } from 'keyanim-three/decoder/kanim.js';
 
 export class BvhError extends Error {
   constructor(line, column, detail) {

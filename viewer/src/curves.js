@@ -1,7 +1,7 @@
 // The curve panel: one channel over time, the original (BVH) against the decoded curve, with
 // the keys marked and the playhead (what `keyanim plot` draws, live).
-import { channelValue } from './sample.js';
-import { CHANNEL_TYPES, nodeLabel } from './kanim.js';
+import { channelValue } from 'keyanim-three/decoder/sample.js';
+import { CHANNEL_TYPES, nodeLabel } from 'keyanim-three/decoder/kanim.js';
 import { COLORS } from './view3d.js';
 
 const css = (hex) => `#${hex.toString(16).padStart(6, '0')}`;

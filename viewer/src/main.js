@@ -1,8 +1,8 @@
 // Entry point of the page: the app, a clip embedded by `keyanim view` if there is one, and the
 // test hook window.keyanim.
 import { App } from './app.js';
-import { samplePose } from './sample.js';
-import { worldPositions } from './pose.js';
+import { samplePose } from 'keyanim-three/decoder/sample.js';
+import { worldPositions } from 'keyanim-three/decoder/pose.js';
 
 const app = new App();
 app.loadEmbedded();

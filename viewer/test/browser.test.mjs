@@ -9,8 +9,8 @@ import os from 'node:os';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { pathToFileURL } from 'node:url';
-import { decodeKanim } from '../src/kanim.js';
-import { skeletonSize } from '../src/pose.js';
+import { decodeKanim } from 'keyanim-three/decoder/kanim.js';
+import { skeletonSize } from 'keyanim-three/decoder/pose.js';
 import { decodePng } from './png.mjs';
 import { corpusDir, keyanimCli, viewerPage, sourceDir, exists } from './paths.mjs';
 

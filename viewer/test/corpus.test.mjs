@@ -8,10 +8,10 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { decodeKanim, nodeLabel } from '../src/kanim.js';
-import { samplePose } from '../src/sample.js';
+import { decodeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
+import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { parseBvh } from '../src/bvh.js';
-import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from '../src/pose.js';
+import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from 'keyanim-three/decoder/pose.js';
 import { corpusDir, keyanimCli, exists, bvhFilesBelow } from './paths.mjs';
 
 const clips = bvhFilesBelow(corpusDir);

@@ -1,8 +1,8 @@
 // Takes a .kanim apart into sections (raw content) and puts one together again, so that tests
 // can make files that break exactly one rule. A section marked compressed is written as a zstd
 // frame of Raw blocks (a valid frame: RFC 8878 3.1.1.2.2), which keeps its content editable.
-import { crc32 } from '../src/crc32.js';
-import { decompressSection } from '../src/zstd.js';
+import { crc32 } from 'keyanim-three/decoder/crc32.js';
+import { decompressSection } from 'keyanim-three/decoder/zstd.js';
 
 const le = (n, bytes) => { const b = new Uint8Array(8); new DataView(b.buffer).setBigUint64(0, BigInt(n), true); return b.subarray(0, bytes); };
 const u32 = (n) => { const b = new Uint8Array(4); new DataView(b.buffer).setUint32(0, n >>> 0, true); return b; };

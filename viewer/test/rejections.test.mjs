@@ -7,7 +7,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
-import { decodeKanim } from '../src/kanim.js';
+import { decodeKanim } from 'keyanim-three/decoder/kanim.js';
 import { splitKanim, buildKanim, fixCrc, zstdRawFrame, concat } from './kanim-builder.mjs';
 import { vectorsDir, keyanimCli, exists } from './paths.mjs';
 

@@ -4,8 +4,8 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { decodeKanim, CHANNEL_TYPES } from '../src/kanim.js';
-import { samplePose } from '../src/sample.js';
+import { decodeKanim, CHANNEL_TYPES } from 'keyanim-three/decoder/kanim.js';
+import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { vectorsDir } from './paths.mjs';
 
 const vectors = fs.readdirSync(vectorsDir).filter((f) => f.endsWith('.kanim')).sort();
