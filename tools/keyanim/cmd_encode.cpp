@@ -104,9 +104,11 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
   if (files.empty()) fail(kBadInput, in + ": no .bvh files found");
   std::vector<std::string> targets;
   for (const std::string& f : files) {
-    std::error_code ec;
-    const std::filesystem::path rel = std::filesystem::relative(f, in, ec);
-    if (ec) fail(kBadInput, f + ": " + ec.message());
+    // Lexically, from the path as listed (IN/...): relative() would resolve a symlinked input
+    // and name its output after the link's target, possibly outside OUTDIR.
+    const std::filesystem::path rel = std::filesystem::path(f).lexically_normal().lexically_relative(
+        std::filesystem::path(in).lexically_normal());
+    if (rel.empty() || *rel.begin() == "..") fail(kBadInput, f + ": not below " + in);
     targets.push_back(swap_extension((std::filesystem::path(out) / rel).string(), ".kanim"));
   }
   check_outputs(files, targets, g);

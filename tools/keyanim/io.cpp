@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <map>
+#include <functional>
 
 #include "keyanim/offline/bvh.h"
 
@@ -172,6 +172,16 @@ void check_directories(const std::string& output) {
   }
 }
 
+// The standard stream (1 or 2) that `path`, a symbolic link, leads to, or -1.
+int stream_behind(const std::string& path) {
+  struct stat st;
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISLNK(st.st_mode) || ::stat(path.c_str(), &st) != 0) return -1;
+  const std::optional<FileId> id = regular_id(st);
+  for (int fd : {STDOUT_FILENO, STDERR_FILENO})
+    if (id && fd_id(fd) == id) return fd;
+  return -1;
+}
+
 }  // namespace
 
 void install_interrupt_cleanup() {
@@ -250,8 +260,17 @@ Output::Output(const std::string& path, bool binary, const Globals& g, const std
     fd_ = STDOUT_FILENO;
     return;
   }
+  const Target target_kind = check_target(path, inputs, g.force);
+  // A link to one of this process's own standard streams (-o /dev/stdout, /dev/fd/2) is that
+  // stream, written through as "-" is: renaming over the link would replace it (as root, in
+  // /dev) and leave the file the shell opened empty.
+  if (const int stream = stream_behind(path); stream >= 0) {
+    fd_ = stream == STDOUT_FILENO ? STDOUT_FILENO : ::dup(stream);
+    if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
+    return;
+  }
   // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
-  if (check_target(path, inputs, g.force) == Target::device) {
+  if (target_kind == Target::device) {
     fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
     if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
     return;
@@ -312,20 +331,42 @@ void Output::commit() {
   unregister_temp(slot_);
 }
 
+void check_not_input(const std::string& output, const std::vector<FileId>& inputs) {
+  struct stat st;
+  if (::stat(output.c_str(), &st) == 0 && contains(inputs, regular_id(st)))
+    fail(kOutputFailed, output + ": is an input; an input is never overwritten, even with -f");
+}
+
+void check_distinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  // By a hash of the lower-case path (16 bytes an entry, for lists of millions), equal hashes
+  // compared in full; the first input by order is named first.
+  auto key = [&](size_t i) {
+    std::string k = fs::path(outputs[i]).lexically_normal().string();
+    std::transform(k.begin(), k.end(), k.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return k;
+  };
+  std::vector<std::pair<size_t, size_t>> order;  // (hash, index)
+  order.reserve(outputs.size());
+  for (size_t i = 0; i < outputs.size(); ++i) order.emplace_back(std::hash<std::string>{}(key(i)), i);
+  std::sort(order.begin(), order.end());
+  for (size_t a = 0; a < order.size(); ++a)
+    for (size_t b = a + 1; b < order.size() && order[b].first == order[a].first; ++b) {
+      const size_t i = order[a].second, j = order[b].second;
+      if (inputs[i] == inputs[j] || key(i) != key(j)) continue;  // one input listed twice is one input
+      fail(kOutputFailed, inputs[i] + " and " + inputs[j] + " would both be written to " + outputs[j] +
+                              (outputs[i] != outputs[j] ? " (or " + outputs[i] + ": the same file where case is ignored)" : "") +
+                              "; rename one of them");
+    }
+}
+
 void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs, const Globals& g) {
+  check_distinct(inputs, outputs);
   std::vector<FileId> ids;
   for (const std::string& in : inputs)
     if (auto id = input_id(in)) ids.push_back(*id);
-  std::map<std::string, size_t> seen;  // output path in lower case -> input index
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    std::string key = outputs[i];
-    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (auto [it, fresh] = seen.emplace(key, i); !fresh)
-      fail(kOutputFailed, inputs[it->second] + " and " + inputs[i] + " would both be written to " + outputs[i] +
-                              (outputs[it->second] != outputs[i] ? " (or " + outputs[it->second] + ": the same file where case is ignored)" : "") +
-                              "; rename one of them");
-    check_target(outputs[i], ids, g.force);
-    check_directories(outputs[i]);
+  for (const std::string& out : outputs) {
+    check_target(out, ids, g.force);
+    check_directories(out);
   }
 }
 

@@ -83,6 +83,15 @@ class Output {
 // The identities of these inputs that are regular files.
 std::vector<FileId> ids_of(const std::vector<const Input*>& inputs);
 
+// Refuses (exit 4) `output` if it is one of `inputs` (for outputs that are appended to, such as
+// a report, which may exist).
+void check_not_input(const std::string& output, const std::vector<FileId>& inputs);
+
+// Refuses (exit 4) two different inputs whose outputs are one file: paths equal ignoring ASCII
+// case (as on case-insensitive file systems) once made lexically normal. The same input listed
+// twice is not a collision. `inputs[i]` is written to `outputs[i]`.
+void check_distinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
 // Before a run over many inputs: refuses (exit 4) outputs that two inputs would share (paths
 // equal ignoring ASCII case, as on case-insensitive file systems), outputs that are inputs,
 // existing outputs without --force, outputs in the way of a directory, and an output
