@@ -13,11 +13,17 @@
 #include <vector>
 
 #include "cli.h"
+#include "guarded_read.h"  // Kind
 
 namespace keyanim::cli {
 
-// On SIGINT/SIGTERM/SIGHUP/SIGPIPE: remove the temporary outputs being written, then die.
+// On SIGINT/SIGTERM/SIGHUP/SIGPIPE/SIGQUIT: remove the temporary outputs being written, then
+// die. SIGXFSZ (past `ulimit -f`) is ignored, so that the write fails and is reported.
 void install_interrupt_cleanup();
+
+// After a command that succeeded: everything it printed reached standard output (exit 4 if not:
+// a full disk, `>/dev/full`), so that lost output is never reported as success.
+void flush_standard_output();
 
 struct FileId {
   dev_t dev = 0;
@@ -27,9 +33,6 @@ struct FileId {
 // The identity of a regular file ("-": standard input), following symlinks; nothing for
 // anything else (a device, a pipe, a missing file), which cannot be lost by writing to it.
 std::optional<FileId> input_id(const std::string& path);
-
-// What a command reads; the first bytes decide, before the rest is read.
-enum class Kind { bvh, kanim, either };
 
 class Input {
  public:
