@@ -1,4 +1,5 @@
 // keyanim decode: .kanim -> BVH, at the source rate or tweened to another one.
+#include <cmath>
 #include <iostream>
 
 #include "commands.h"
@@ -47,6 +48,8 @@ int cmd_decode(const Argv& argv, Globals& g) {
   if (args.has("--fps") && args.has("--inbetweens")) fail(kUsage, "--fps and --inbetweens exclude each other");
   opt.fps = args.get_double("--fps", 0.0);
   if (args.has("--fps") && !(opt.fps > 0.0)) fail(kUsage, "--fps must be positive");
+  if (args.has("--fps") && !std::isfinite(1.0 / opt.fps))  // 1e-309: Frame Time: inf, unreadable
+    fail(kUsage, "--fps " + *args.get("--fps") + ": the frame time 1/F is not a finite number");
   opt.inbetweens = args.get_uint("--inbetweens", 0);
   if (auto r = args.get("--frames")) {
     const size_t colon = r->find(':');

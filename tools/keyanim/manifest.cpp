@@ -172,7 +172,9 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
   const std::vector<std::string> all = distinct(manifest_entries(text));
   check_manifest_outputs(all, outdir, report_path);
   std::vector<std::string> inputs;
-  for (uint64_t i = shard.index; i < all.size(); i += shard.count) inputs.push_back(all[size_t(i)]);
+  // (i + count could wrap around with a huge N and take every entry: step only while it fits.)
+  for (uint64_t i = shard.index; i < all.size(); i = all.size() - i > shard.count ? i + shard.count : all.size())
+    inputs.push_back(all[size_t(i)]);
   if (!report_path.empty()) check_report(report_path, list, inputs);
   const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
   Report report(report_path);
@@ -202,6 +204,9 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
         }
         mine.force = true;  // damaged or incomplete: replaced
       }
+      // Another run on the same OUTDIR may finish this very output first: with --skip-existing
+      // that is no failure, and the rename replaces it, atomically, with an equal encoding.
+      if (skip_existing) mine.force = true;
       fs::create_directories(fs::path(out).parent_path(), ec);
       if (ec) fail(kOutputFailed, fs::path(out).parent_path().string() + ": cannot create: " + ec.message());
       const nlohmann::json r = encode_one(in, out, one, args.has("--error"), mine).summary;
