@@ -140,3 +140,13 @@ def test_dataset_takes_numpy_integers(keyanim):
     for bad in (True, np.bool_(True), 2.0, 0):
         with pytest.raises(ValueError, match="window must be an integer"):
             keyanim.Dataset([WALK], window=bad)
+
+
+# Class 7: errors that say what happened.
+def test_encode_settings_out_of_range_say_so(keyanim, walk):
+    with pytest.raises(keyanim.Error, match="level is out of range"):
+        keyanim.encode(walk, level=2 ** 40)
+    with pytest.raises(TypeError, match="level must be an integer"):
+        keyanim.encode(walk, level=True)
+    with pytest.raises(keyanim.Error, match="threads is out of range"):
+        keyanim.encode(walk, threads=-2 ** 63 - 1)

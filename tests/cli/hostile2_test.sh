@@ -8,7 +8,8 @@
 #               SIGQUIT
 #   endless     reads that never end: FIFOs and /dev/zero where a command reads back
 #   report_names  a name that is not UTF-8 in a report keeps its line (and its bytes)
-#   wrong_results --shard with a huge N, two --skip-existing runs at once
+#   wrong_results --shard with a huge N, two --skip-existing runs at once, an infinite frame time
+#   messages    errors that say what happened: tiny tolerances, an unreachable tolerance
 set -uo pipefail
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
@@ -194,6 +195,16 @@ wrong_results)
   done
   [ ! -e slow.bvh ] || die "a refused decode left an output"
   no_temps .
+  ;;
+messages)
+  # Errors that say what happened: tiny tolerances printed as numbers (not 0.000000), and an
+  # unreachable tolerance is a limit reached (6), not bad input (2).
+  "$K" -q encode "$WALK" -o w.kanim || die "encode"
+  expect_rc 5 "$K" verify w.kanim --against "$WALK" --max-error 1e-9
+  grep -q 'exceeds 1e-09' "$T/.stderr" || die "verify --max-error 1e-9: $(cat "$T/.stderr")"
+  expect_rc 6 "$K" encode "$WALK" -o tiny.kanim --error 1e-30
+  grep -q 'could not reach the tolerance' "$T/.stderr" || die "encode --error 1e-30: $(cat "$T/.stderr")"
+  [ ! -e tiny.kanim ] || die "a failed encode left an output"
   ;;
 *) die "unknown case $CASE" ;;
 esac

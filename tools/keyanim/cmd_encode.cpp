@@ -60,7 +60,15 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
   settings.progress = progress.encoding();
-  const offline::EncodeResult result = or_fail(kBadInput, in + ": ", [&] { return offline::encode(motion, settings); });
+  // The exit code follows the kind of error: a tolerance below float32 precision is a limit
+  // reached (6), not bad input (2).
+  offline::EncodeResult result;
+  try {
+    result = offline::encode(motion, settings);
+  } catch (const offline::Error& e) {
+    const Failure f = failure_of(e);
+    fail(f.code, in + ": " + f.message);
+  }
   std::vector<double>().swap(motion.values);
   progress.compressing();
   // encode() made a clip the container can store: write_kanim cannot fail here.
