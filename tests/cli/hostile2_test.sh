@@ -194,6 +194,14 @@ wrong_results)
     grep -q 'frame time' "$T/.stderr" || die "--fps $fps: the refusal does not say why: $(cat "$T/.stderr")"
   done
   [ ! -e slow.bvh ] || die "a refused decode left an output"
+  # --frames past the last frame is refused, whatever the number (4294967295 was "to the end").
+  for range in 0:344 0:4294967295; do
+    for o in fr.bvh fr.glb; do
+      expect_rc 1 "$K" decode out/in/w0.kanim --frames "$range" -o "$o"
+      grep -q 'the clip has frames 0 to' "$T/.stderr" || die "--frames $range -o $o: $(cat "$T/.stderr")"
+    done
+  done
+  [ ! -e fr.bvh ] && [ ! -e fr.glb ] || die "a refused decode left an output"
   no_temps .
   ;;
 messages)

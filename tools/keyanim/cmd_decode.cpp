@@ -62,7 +62,8 @@ int cmd_decode(const Argv& argv, Globals& g) {
   if (gltf) return decode_gltf(input, out, opt, args, g);
   Output output(out, false, g, ids_of({&input}));
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
-  if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())
+  // (Given, not the UINT32_MAX default: --frames 0:4294967295 was taken for "to the end".)
+  if (args.has("--frames") && opt.last_frame >= clip.frame_count())
     fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
   offline::FrameDecoder decoder;
   or_fail(kUsage, "", [&] { decoder.start(clip, opt); });
