@@ -1,7 +1,9 @@
 """keyanim.Dataset: fixed-length windows over many clips, for training loops."""
 
 import math
+import operator
 import os
+import stat
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -13,8 +15,25 @@ _KANIM_SIGNATURE = b"\x89KAN"
 
 
 def _is_kanim(path):
+    # Only a regular file: a FIFO would block the open (and its read) for ever, a device such
+    # as /dev/zero never end.
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise Error("%s: not a regular file" % os.fsdecode(path))
     with open(path, "rb") as f:
         return f.read(4) == _KANIM_SIGNATURE
+
+
+def _whole(value, name):
+    """An integer >= 1: int or numpy integer (anything with __index__), not bool."""
+    whole = None
+    if not isinstance(value, (bool, np.bool_)):
+        try:
+            whole = operator.index(value)
+        except TypeError:
+            pass
+    if whole is None or whole < 1:
+        raise ValueError("%s must be an integer >= 1, got %r" % (name, value))
+    return whole
 
 
 def _collect(paths_or_directory):
@@ -27,8 +46,9 @@ def _collect(paths_or_directory):
         for dirpath, _, filenames in os.walk(root):
             for name in filenames:
                 lower = os.fsdecode(name).lower()
-                if lower.endswith(".kanim") or lower.endswith(".bvh"):
-                    found.append(os.path.join(dirpath, name))
+                full = os.path.join(dirpath, name)
+                if (lower.endswith(".kanim") or lower.endswith(".bvh")) and os.path.isfile(full):
+                    found.append(full)  # regular files only (a FIFO named x.bvh is left out)
         return sorted(found)
     return [os.fspath(p) for p in paths_or_directory]
 
@@ -36,6 +56,7 @@ def _collect(paths_or_directory):
 def _load(path):
     """A .kanim (recognised by its signature) as it is; anything else read as BVH once and kept
     as a clip with every frame a key (Clip.from_motion)."""
+    path = os.fsdecode(path)  # a bytes path is a path, not a clip's bytes (Clip(bytes))
     if _is_kanim(path):
         return Clip(path)
     return Clip.from_motion(read_bvh(path))
@@ -76,11 +97,8 @@ class Dataset:
         self.paths = _collect(paths_or_directory)
         if not self.paths:
             raise ValueError("no .kanim or .bvh files in %r" % (paths_or_directory,))
-        if isinstance(window, bool) or not isinstance(window, int) or window < 1:
-            raise ValueError("window must be an integer >= 1, got %r" % (window,))
-        stride = window if stride is None else stride
-        if isinstance(stride, bool) or not isinstance(stride, int) or stride < 1:
-            raise ValueError("stride must be an integer >= 1, got %r" % (stride,))
+        window = _whole(window, "window")
+        stride = window if stride is None else _whole(stride, "stride")
         if fps is not None and not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0):
             raise ValueError("fps must be None or a positive number, got %r" % (fps,))
         names = (output,) if isinstance(output, str) else tuple(output)

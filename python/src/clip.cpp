@@ -7,6 +7,7 @@
 
 #include "common.h"
 #include "dense_clip.h"
+#include "keyanim/offline/guarded_read.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/error.h"
 
@@ -23,20 +24,15 @@ double rate_arg(const PyClip& c, const py::object& fps) {
   return r;
 }
 
-// The whole file, or Error::io with errno; Error (limit) past the loader's size limit.
-std::vector<uint8_t> read_file(const std::string& path, uint64_t max_bytes) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) throw offline::Error::io(path, "cannot open file", errno);
-  std::vector<uint8_t> bytes;
-  uint8_t chunk[1 << 16];
-  for (;;) {
-    const size_t n = std::fread(chunk, 1, sizeof chunk, f.get());
-    if (bytes.size() + n > max_bytes)
-      throw offline::Error(offline::ErrorKind::limit, "larger than the loader's limit of " + std::to_string(max_bytes) + " bytes", path);
-    bytes.insert(bytes.end(), chunk, chunk + n);
-    if (n < sizeof chunk) break;
-  }
-  if (std::ferror(f.get())) throw offline::Error::io(path, "cannot read file", errno ? errno : EIO);
+// The bytes of a buffer in C order: a strided or reversed view (memoryview(b)[::-1]) is
+// copied element by element as Python would (bytes(view)), never read past its memory.
+std::vector<uint8_t> buffer_bytes(const py::object& source) {
+  Py_buffer view;
+  if (PyObject_GetBuffer(source.ptr(), &view, PyBUF_FULL_RO) != 0) throw py::error_already_set();
+  std::vector<uint8_t> bytes(size_t(view.len));
+  const int r = PyBuffer_ToContiguous(bytes.data(), &view, view.len, 'C');
+  PyBuffer_Release(&view);
+  if (r != 0) throw py::error_already_set();
   return bytes;
 }
 
@@ -46,14 +42,12 @@ std::shared_ptr<PyClip> load(const py::object& source) {
   const bool in_memory = py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source) ||
                          py::isinstance<py::memoryview>(source);
   if (in_memory) {
-    const py::buffer_info buf = py::reinterpret_borrow<py::buffer>(source).request();
-    const auto* data = static_cast<const uint8_t*>(buf.ptr);
-    bytes.assign(data, data + buf.size * buf.itemsize);
+    bytes = buffer_bytes(source);
   } else {
     c->file = path_of(source);
   }
   py::gil_scoped_release unlocked;
-  if (c->file) bytes = read_file(*c->file, DecodeLimits{}.max_decompressed_bytes);
+  if (c->file) bytes = offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
   ErrorInfo info;
   if (Clip::load(bytes, c->clip, &info) != Status::ok) throw offline::Error::kanim(c->file.value_or(""), info);
   c->bytes = bytes.size();
@@ -126,7 +120,9 @@ void register_clip(py::module_& m) {
   cls.attr("__module__") = "keyanim";  // as users import it (signatures say keyanim.Clip)
   cls.def(py::init(&load), py::arg("path_or_bytes"),
           "Loads a .kanim from a path (str or os.PathLike) or from bytes (bytes, bytearray,\n"
-          "memoryview).");
+          "memoryview; a view that is not C-contiguous, such as memoryview(b)[::2], is copied in\n"
+          "order first, as bytes(view) would). A file is refused by its first bytes if it is not\n"
+          "a .kanim (/dev/zero), and past 1 GiB.");
   cls.def_static(
       "from_motion",
       [](const PyMotion& motion) {
@@ -264,6 +260,11 @@ void register_clip(py::module_& m) {
       [](const PyClip& c, const py::object& fps) {
         offline::ResampleOptions options;
         if (!fps.is_none()) options.fps = fps.cast<double>();
+        // As decode --fps: a rate whose frame time 1/fps is not a positive finite number (1e-320)
+        // would write Frame Time: inf, which no reader takes back.
+        if (!fps.is_none() && !(options.fps > 0.0 && std::isfinite(options.fps) && std::isfinite(1.0 / options.fps)))
+          throw offline::Error(offline::ErrorKind::invalid_argument,
+                               "fps must be a positive number with a finite frame time 1/fps, got " + std::string(py::repr(fps)));
         auto out = std::make_shared<PyMotion>();
         py::gil_scoped_release unlocked;
         out->motion = offline::decode_motion(c.clip, options);

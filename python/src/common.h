@@ -33,6 +33,10 @@ struct PyClip {
   uint64_t bytes = 0;
 };
 
+// The most read from one file (read_bvh, Clip): the CLI's default --max-input, 1 GiB.
+inline constexpr uint64_t kMaxInputBytes = uint64_t(1) << 30;
+inline constexpr const char* kLimitHint = "the module reads at most 1 GiB of a file";
+
 // Text from files (joint names, notes) may hold any bytes: bytes that are not UTF-8 become
 // lone surrogates (PEP 383, "surrogateescape"), as `keyanim ... --json` writes them.
 py::str text(const std::string& bytes);

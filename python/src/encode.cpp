@@ -1,6 +1,7 @@
 // keyanim.encode: a Motion to .kanim bytes and the report `keyanim encode --json` prints.
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 
 #include "common.h"
 #include "keyanim/offline/container.h"
@@ -52,6 +53,17 @@ void set_keys(const py::handle& keys, offline::EncodeSettings& s) {
   if (s.manual_frames.empty()) invalid("keys: the list of key frames is empty");
 }
 
+// A whole number for setting `name` (int or numpy integer, not bool): out of int range is the
+// setting's own error, not pybind11's "Unable to cast".
+int whole_setting(const py::handle& value, const char* name) {
+  if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr()))
+    throw py::type_error(std::string(name) + " must be an integer, got " + std::string(py::repr(value)));
+  const long long v = PyLong_AsLongLong(py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr())).ptr());
+  if (PyErr_Occurred()) PyErr_Clear();
+  else if (v >= INT32_MIN && v <= INT32_MAX) return int(v);
+  invalid(std::string(name) + " is out of range: " + std::string(py::repr(value)));
+}
+
 // The keyword settings, each as `keyanim encode` names it where it has an option.
 void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
   for (const auto& [key, value] : kwargs) {
@@ -63,9 +75,9 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
       else if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) s.tension = value.cast<float>();
       else throw py::type_error("tension must be a number in [-1, 1] or 'fit'");
     } else if (name == "level") {
-      s.zstd_level = value.cast<int>();
+      s.zstd_level = whole_setting(value, "level");
     } else if (name == "threads") {
-      const int t = value.cast<int>();
+      const int t = whole_setting(value, "threads");
       if (t < 0) invalid("threads must be >= 0 (0: one per core)");
       s.threads = uint32_t(t);
     } else if (name == "tangent_rule") {

@@ -4,11 +4,14 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
 #include "common.h"
+#include "keyanim/offline/guarded_read.h"
+#include "keyanim/offline/in_place.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/error.h"
@@ -26,10 +29,12 @@ PyMotion read(const py::object& path_arg) {
   std::vector<std::string> warnings;
   {
     py::gil_scoped_release unlocked;
-    m.motion = offline::read_bvh_file(*m.source, &warnings);
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(*m.source, ec);
-    if (!ec) m.bvh_bytes = size;
+    // The CLI's guards (guarded_read.h): /dev/zero or a binary file is refused by its first
+    // bytes, and nothing past the limit is read.
+    const std::vector<uint8_t> bytes = offline::read_file_guarded(*m.source, offline::InputKind::bvh, kMaxInputBytes, kLimitHint);
+    m.motion = offline::read_bvh(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                                 *m.source, &warnings);
+    m.bvh_bytes = bytes.size();
   }
   for (const std::string& w : warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, std::string(py::str(text(w))).c_str(), 1) != 0) throw py::error_already_set();
@@ -37,32 +42,51 @@ PyMotion read(const py::object& path_arg) {
 }
 
 // Writes through a temporary file beside `path`, renamed over it once complete; an existing
-// file is replaced only with overwrite.
+// file is replaced only with overwrite. A device, a FIFO or a link to one, or to a standard
+// stream, is written in place (the CLI's rule, in_place.h), never renamed over.
 void write_bvh_file(const offline::Motion& motion, const std::string& path, bool overwrite) {
   std::error_code ec;
   if (!overwrite && std::filesystem::symlink_status(path, ec).type() != std::filesystem::file_type::not_found && !ec)
     throw offline::Error::io(path, "exists (pass overwrite=True to replace it)", EEXIST);
-  const std::filesystem::path target(path);
-  const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
-  std::string temp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
-  const int fd = mkstemp(temp.data());
-  if (fd < 0) throw offline::Error::io(path, "cannot create a temporary file beside it", errno);
+  // BVH text holds finite numbers only: nan or inf (set through `channels`) would write a file
+  // that no reader takes back.
+  if (!std::isfinite(motion.frame_time) || motion.frame_time < 0.0)
+    throw offline::Error(offline::ErrorKind::invalid_argument, "the frame time is " + std::to_string(motion.frame_time) +
+                                                                   ": BVH text cannot hold it", path);
+  for (size_t i = 0; i < motion.values.size(); ++i)
+    if (!std::isfinite(motion.values[i]))
+      throw offline::Error(offline::ErrorKind::invalid_argument,
+                           "channel " + std::to_string(i % motion.channel_count()) + " of frame " +
+                               std::to_string(i / motion.channel_count()) + " is " + std::to_string(motion.values[i]) +
+                               ": BVH text holds finite numbers only",
+                           path);
+  int fd = offline::open_in_place(path);
+  if (fd == -2) throw offline::Error::io(path, "cannot open", errno);
+  std::string temp;
+  if (fd < 0) {
+    const std::filesystem::path target(path);
+    const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
+    temp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+    fd = mkstemp(temp.data());
+    if (fd < 0) throw offline::Error::io(path, "cannot create a temporary file beside it", errno);
+  }
   int failed = 0;
   auto put = [&](std::string_view chunk) {
     for (size_t done = 0; done < chunk.size() && !failed;) {
       const ssize_t n = ::write(fd, chunk.data() + done, chunk.size() - done);
       if (n < 0 && errno != EINTR) failed = errno;
+      if (n == 0) failed = EIO;
       if (n > 0) done += size_t(n);
     }
   };
   offline::BvhWriter writer(motion.skeleton, motion.frame_count, motion.frame_time, put);
   for (uint32_t f = 0; f < motion.frame_count && !failed; ++f) writer.frame(motion.frame(f));
   writer.finish();
-  if (!failed && ::fchmod(fd, 0644) != 0) failed = errno;
+  if (!failed && !temp.empty() && ::fchmod(fd, 0644) != 0) failed = errno;
   if (::close(fd) != 0 && !failed) failed = errno;
-  if (!failed && std::rename(temp.c_str(), path.c_str()) != 0) failed = errno;
+  if (!failed && !temp.empty() && std::rename(temp.c_str(), path.c_str()) != 0) failed = errno;
   if (failed) {
-    std::remove(temp.c_str());
+    if (!temp.empty()) std::remove(temp.c_str());
     throw offline::Error::io(path, "cannot write", failed);
   }
 }

@@ -1,4 +1,5 @@
 // keyanim decode: .kanim -> BVH, at the source rate or tweened to another one.
+#include <cmath>
 #include <iostream>
 
 #include "commands.h"
@@ -50,6 +51,8 @@ int cmd_decode(const Argv& argv, Globals& g) {
   if (args.has("--fps") && args.has("--inbetweens")) fail(kUsage, "--fps and --inbetweens exclude each other");
   opt.fps = args.get_double("--fps", 0.0);
   if (args.has("--fps") && !(opt.fps > 0.0)) fail(kUsage, "--fps must be positive");
+  if (args.has("--fps") && !std::isfinite(1.0 / opt.fps))  // 1e-309: Frame Time: inf, unreadable
+    fail(kUsage, "--fps " + *args.get("--fps") + ": the frame time 1/F is not a finite number");
   opt.inbetweens = args.get_uint("--inbetweens", 0);
   if (auto r = args.get("--frames")) {
     const size_t colon = r->find(':');
@@ -62,7 +65,8 @@ int cmd_decode(const Argv& argv, Globals& g) {
   if (gltf) return decode_gltf(input, out, opt, args, g);
   Output output(out, false, g, ids_of({&input}));
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
-  if (opt.last_frame != UINT32_MAX && opt.last_frame >= clip.frame_count())
+  // (Given, not the UINT32_MAX default: --frames 0:4294967295 was taken for "to the end".)
+  if (args.has("--frames") && opt.last_frame >= clip.frame_count())
     fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
   offline::FrameDecoder decoder;
   or_fail(kUsage, "", [&] { decoder.start(clip, opt); });

@@ -60,7 +60,15 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   check_settings_for(settings, motion, in);
   const auto t0 = std::chrono::steady_clock::now();
   settings.progress = progress.encoding();
-  const offline::EncodeResult result = or_fail(kBadInput, in + ": ", [&] { return offline::encode(motion, settings); });
+  // The exit code follows the kind of error: a tolerance below float32 precision is a limit
+  // reached (6), not bad input (2).
+  offline::EncodeResult result;
+  try {
+    result = offline::encode(motion, settings);
+  } catch (const offline::Error& e) {
+    const Failure f = failure_of(e);
+    fail(f.code, in + ": " + f.message);
+  }
   std::vector<double>().swap(motion.values);
   progress.compressing();
   // encode() made a clip the container can store: write_kanim cannot fail here.
@@ -104,9 +112,11 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
   if (files.empty()) fail(kBadInput, in + ": no .bvh files found");
   std::vector<std::string> targets;
   for (const std::string& f : files) {
-    std::error_code ec;
-    const std::filesystem::path rel = std::filesystem::relative(f, in, ec);
-    if (ec) fail(kBadInput, f + ": " + ec.message());
+    // Lexically, from the path as listed (IN/...): relative() would resolve a symlinked input
+    // and name its output after the link's target, possibly outside OUTDIR.
+    const std::filesystem::path rel = std::filesystem::path(f).lexically_normal().lexically_relative(
+        std::filesystem::path(in).lexically_normal());
+    if (rel.empty() || *rel.begin() == "..") fail(kBadInput, f + ": not below " + in);
     targets.push_back(swap_extension((std::filesystem::path(out) / rel).string(), ".kanim"));
   }
   check_outputs(files, targets, g);

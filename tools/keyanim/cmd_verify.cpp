@@ -77,7 +77,8 @@ int cmd_verify(const Argv& argv, Globals& g) {
         j["max_error_allowed"] = units;
         if (!(e.max_error <= units)) {
           ok = false;
-          why = "error " + std::to_string(e.max_error) + " exceeds " + std::to_string(units);
+          // Shortest round-trip text: to_string's %f printed a tolerance of 1e-9 as 0.000000.
+          why = "error " + json_text(e.max_error) + " exceeds " + json_text(units);
         }
       }
       if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + offline::error_text(orig.skeleton, e)) << "\n";

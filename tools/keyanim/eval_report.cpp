@@ -4,6 +4,7 @@
 #include <map>
 #include <sstream>
 
+#include "escape.h"
 #include "rd_plot.h"
 #include "settings.h"
 
@@ -155,7 +156,7 @@ std::string eval_jsonl(const std::vector<nlohmann::json>& files) {
                              {"bytes_per_second", seconds > 0 ? nlohmann::json(r["kanim_bytes"].get<double>() / seconds) : nullptr},
                              {"encode_ms", r["encode_ms"]},
                              {"decode_ms", r["decode_ms"]}};
-      out += line.dump() + "\n";
+      out += json_text(line) + "\n";  // names that are not UTF-8 keep their bytes
     }
   }
   for (const Total& t : totals(files)) {
@@ -171,7 +172,7 @@ std::string eval_jsonl(const std::vector<nlohmann::json>& files) {
                                  {"bytes_per_second", t.seconds > 0 ? nlohmann::json(t.bytes / t.seconds) : nullptr},
                                  {"max_error_percent", t.max_percent},
                                  {"encode_ms", t.encode_ms}};
-    out += line.dump() + "\n";
+    out += json_text(line) + "\n";
   }
   return out;
 }

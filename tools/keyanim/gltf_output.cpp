@@ -72,6 +72,8 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
   Output main(out, !split, g, ids_of({&input}));
 
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
+  if (args.has("--frames") && o.last_frame >= clip.frame_count())  // as the BVH output (cmd_decode.cpp)
+    fail(kUsage, "--frames: the clip has frames 0 to " + std::to_string(int64_t(clip.frame_count()) - 1));
   check_values(clip.frame_count(), clip.channel_count(), "exporting " + in, g);
   Progress bar(g, in);
   EncodeProgress progress(&bar, o.fps == 0.0, false);

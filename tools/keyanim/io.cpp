@@ -12,8 +12,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <map>
+#include <functional>
+#include <iostream>
 
+#include "keyanim/offline/guarded_read.h"
+#include "keyanim/offline/in_place.h"
 #include "keyanim/offline/bvh.h"
 
 namespace keyanim::cli {
@@ -76,58 +79,19 @@ bool contains(const std::vector<FileId>& ids, const std::optional<FileId>& id) {
   return id && std::find(ids.begin(), ids.end(), *id) != ids.end();
 }
 
-// Reads into `bytes` until it holds `want` bytes or the input ends; false at the end.
-bool fill(int fd, const std::string& path, std::vector<uint8_t>& bytes, size_t want) {
-  while (bytes.size() < want) {
-    const size_t at = bytes.size();
-    bytes.resize(want);
-    const ssize_t n = ::read(fd, bytes.data() + at, want - at);
-    bytes.resize(at + size_t(std::max<ssize_t>(n, 0)));
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) fail(kBadInput, path + ": read error: " + std::strerror(errno));
-    if (n == 0) return false;
+// Runs `work`, a guarded read (guarded_read.h): its offline::Error fails with the code of its
+// kind (2 unreadable or malformed, 6 a limit).
+template <class Work>
+auto guarded(Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const offline::Error& e) {
+    const Failure f = failure_of(e);
+    fail(f.code, f.message);
   }
-  return true;
 }
 
-enum class Start { yes, no, undecided };
-
-// Whether `b` can start BVH text: blanks and a UTF-8 byte order mark, then HIERARCHY in any
-// case (what the reader accepts). Undecided while only blanks have been seen.
-Start bvh_start(const std::vector<uint8_t>& b) {
-  size_t i = b.size() >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF ? 3 : 0;
-  while (i < b.size() && (b[i] == ' ' || (b[i] >= '\t' && b[i] <= '\r'))) ++i;
-  const char* word = "hierarchy";
-  for (size_t k = 0; k < 9; ++k, ++i) {
-    if (i == b.size()) return Start::undecided;
-    if (std::tolower(b[i]) != word[k]) return Start::no;
-  }
-  return Start::yes;
-}
-
-// Fails (exit 2) unless the first bytes read can start a `kind` file, naming what is wrong as
-// the reader would for BVH text (file:line:column). Undecided when only blanks were read.
-Start check_start(const std::string& path, const std::vector<uint8_t>& b, Kind kind) {
-  static const uint8_t kMagic[4] = {0x89, 'K', 'A', 'N'};
-  const bool kanim = std::equal(b.begin(), b.begin() + std::min<size_t>(b.size(), 4), kMagic) && !b.empty();
-  if (kind == Kind::kanim) {
-    if (!kanim && !b.empty()) fail(kBadInput, path + ": not a .kanim file (bad signature)");
-    return Start::yes;
-  }
-  if (kanim && b.size() >= 4) {
-    if (kind == Kind::bvh) fail(kBadInput, path + ": is a .kanim file, expected BVH text");
-    return Start::yes;
-  }
-  const Start s = bvh_start(b);
-  if (s != Start::no) return s;
-  const std::string_view text(reinterpret_cast<const char*>(b.data()), b.size());
-  or_fail(kBadInput, "", [&] { return offline::read_bvh(text, path); });
-  fail(kBadInput, path + ": not BVH text");  // not reached: the reader wants HIERARCHY first
-}
-
-std::string too_large(const std::string& path, uint64_t max) {
-  return path + ": larger than the input limit of " + std::to_string(max) + " bytes (raise it with --max-input SIZE)";
-}
+const char* const kLimitHint = "raise it with --max-input SIZE";
 
 // The parent directory of `path` as a path that can be passed to the system ("." if none).
 fs::path parent_of(const std::string& path) {
@@ -135,22 +99,19 @@ fs::path parent_of(const std::string& path) {
   return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
 
-enum class Target { absent, file, device };
-
 // What is at an output path, after the checks every output gets (exit 4): it is not an input,
 // not a directory, and not an existing file or symbolic link unless --force.
-Target check_target(const std::string& path, const std::vector<FileId>& inputs, bool force) {
+void check_target(const std::string& path, const std::vector<FileId>& inputs, bool force) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) {
     if (::lstat(path.c_str(), &st) == 0 && !force)
       fail(kOutputFailed, path + ": already exists (a symbolic link); not overwritten (use -f)");
-    return Target::absent;
+    return;
   }
   if (contains(inputs, regular_id(st)))
     fail(kOutputFailed, path + ": is an input; an input is never overwritten, even with -f");
   if (S_ISDIR(st.st_mode)) fail(kOutputFailed, path + ": is a directory");
   if (!force) fail(kOutputFailed, path + ": already exists; not overwritten (use -f)");
-  return S_ISREG(st.st_mode) ? Target::file : Target::device;
 }
 
 // Every directory on the way to `output` must be a directory, or not exist yet (a directory run
@@ -175,7 +136,18 @@ void check_directories(const std::string& output) {
 }  // namespace
 
 void install_interrupt_cleanup() {
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) std::signal(sig, remove_temps_and_die);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT}) std::signal(sig, remove_temps_and_die);
+  // Past `ulimit -f` a write then fails with EFBIG, reported (exit 4) and cleaned up like a full
+  // disk, instead of the process dying of SIGXFSZ with its temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
+}
+
+void flush_standard_output() {
+  errno = 0;
+  std::cout.flush();
+  const bool lost = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  const int err = errno;
+  if (lost) fail(kOutputFailed, "-: cannot write standard output" + (err ? ": " + std::string(std::strerror(err)) : std::string()));
 }
 
 std::optional<FileId> input_id(const std::string& path) {
@@ -186,24 +158,24 @@ std::optional<FileId> input_id(const std::string& path) {
 }
 
 Input::Input(const std::string& path, const Globals& g) : path_(path), max_bytes_(g.limits.max_input_bytes) {
+  struct stat st;
   if (path == "-") {
     fd_ = STDIN_FILENO;
+    if (::fstat(fd_, &st) != 0) fail(kBadInput, "-: cannot read: " + std::string(std::strerror(errno)));
+    if (S_ISDIR(st.st_mode)) fail(kBadInput, "-: is a directory");
+    if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes_)
+      fail(kLimit, "-: larger than the input limit of " + std::to_string(max_bytes_) + " bytes (" + kLimitHint + ")");
+    id_ = regular_id(st);
   } else {
-    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd_ < 0) fail(kBadInput, path + ": cannot open: " + std::strerror(errno));
+    const offline::OpenedInput in = guarded([&] { return offline::open_guarded(path, max_bytes_, kLimitHint); });
+    fd_ = in.fd;
+    if (::fstat(fd_, &st) == 0) id_ = regular_id(st);
   }
-  auto refuse = [&](int code, const std::string& message) {  // the destructor will not run
-    if (fd_ > STDIN_FILENO) ::close(fd_);
-    fail(code, message);
-  };
-  struct stat st;
-  if (::fstat(fd_, &st) != 0) refuse(kBadInput, path + ": cannot read: " + std::strerror(errno));
-  if (S_ISDIR(st.st_mode)) refuse(kBadInput, path + ": is a directory");
-  if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > max_bytes_) refuse(kLimit, too_large(path, max_bytes_));
-  id_ = regular_id(st);
   if (id_) size_hint_ = uint64_t(st.st_size);
-  if (id_ && fd_id(STDOUT_FILENO) == id_)
-    refuse(kOutputFailed, path + ": is also standard output; an input is never written to");
+  if (id_ && fd_id(STDOUT_FILENO) == id_) {
+    if (fd_ > STDIN_FILENO) ::close(fd_);  // the destructor will not run
+    fail(kOutputFailed, path + ": is also standard output; an input is never written to");
+  }
 }
 
 Input::~Input() {
@@ -211,18 +183,7 @@ Input::~Input() {
 }
 
 std::vector<uint8_t> Input::read(Kind kind) {
-  std::vector<uint8_t> bytes;
-  // The first bytes decide whether to read on; then all of a regular file at once (one more
-  // byte to see that it has not grown), or doubling chunks of a stream.
-  uint64_t want = 1 << 16;
-  Start start = Start::undecided;
-  for (bool more = true; more;) {
-    more = fill(fd_, path_, bytes, size_t(std::min(want, max_bytes_ + 1)));
-    if (bytes.size() > max_bytes_) fail(kLimit, too_large(path_, max_bytes_));
-    if (start == Start::undecided) start = check_start(path_, bytes, kind);
-    want = std::max<uint64_t>({want * 2, size_hint_ + 1});
-  }
-  return bytes;
+  return guarded([&] { return offline::read_guarded(fd_, path_, kind, max_bytes_, size_hint_, kLimitHint); });
 }
 
 std::vector<uint8_t> read_input(const std::string& path, Kind kind, const Globals& g) {
@@ -250,12 +211,12 @@ Output::Output(const std::string& path, bool binary, const Globals& g, const std
     fd_ = STDOUT_FILENO;
     return;
   }
-  // An existing device or pipe (e.g. -f -o /dev/null) is written to, never replaced by a file.
-  if (check_target(path, inputs, g.force) == Target::device) {
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd_ < 0) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
-    return;
-  }
+  // An existing device, pipe or link to one (-f -o /dev/null), or a link to this process's own
+  // standard output or error (-o /dev/stdout), is written in place, never renamed over.
+  check_target(path, inputs, g.force);
+  fd_ = offline::open_in_place(path);
+  if (fd_ == -2) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
+  if (fd_ >= 0) return;
   // A temporary file beside the target, renamed over it only once complete.
   const fs::path target(path);
   std::string tmpl = (target.has_parent_path() ? target.parent_path() / "" : fs::path()).string() + "." +
@@ -312,20 +273,42 @@ void Output::commit() {
   unregister_temp(slot_);
 }
 
+void check_not_input(const std::string& output, const std::vector<FileId>& inputs) {
+  struct stat st;
+  if (::stat(output.c_str(), &st) == 0 && contains(inputs, regular_id(st)))
+    fail(kOutputFailed, output + ": is an input; an input is never overwritten, even with -f");
+}
+
+void check_distinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  // By a hash of the lower-case path (16 bytes an entry, for lists of millions), equal hashes
+  // compared in full; the first input by order is named first.
+  auto key = [&](size_t i) {
+    std::string k = fs::path(outputs[i]).lexically_normal().string();
+    std::transform(k.begin(), k.end(), k.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return k;
+  };
+  std::vector<std::pair<size_t, size_t>> order;  // (hash, index)
+  order.reserve(outputs.size());
+  for (size_t i = 0; i < outputs.size(); ++i) order.emplace_back(std::hash<std::string>{}(key(i)), i);
+  std::sort(order.begin(), order.end());
+  for (size_t a = 0; a < order.size(); ++a)
+    for (size_t b = a + 1; b < order.size() && order[b].first == order[a].first; ++b) {
+      const size_t i = order[a].second, j = order[b].second;
+      if (inputs[i] == inputs[j] || key(i) != key(j)) continue;  // one input listed twice is one input
+      fail(kOutputFailed, inputs[i] + " and " + inputs[j] + " would both be written to " + outputs[j] +
+                              (outputs[i] != outputs[j] ? " (or " + outputs[i] + ": the same file where case is ignored)" : "") +
+                              "; rename one of them");
+    }
+}
+
 void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs, const Globals& g) {
+  check_distinct(inputs, outputs);
   std::vector<FileId> ids;
   for (const std::string& in : inputs)
     if (auto id = input_id(in)) ids.push_back(*id);
-  std::map<std::string, size_t> seen;  // output path in lower case -> input index
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    std::string key = outputs[i];
-    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (auto [it, fresh] = seen.emplace(key, i); !fresh)
-      fail(kOutputFailed, inputs[it->second] + " and " + inputs[i] + " would both be written to " + outputs[i] +
-                              (outputs[it->second] != outputs[i] ? " (or " + outputs[it->second] + ": the same file where case is ignored)" : "") +
-                              "; rename one of them");
-    check_target(outputs[i], ids, g.force);
-    check_directories(outputs[i]);
+  for (const std::string& out : outputs) {
+    check_target(out, ids, g.force);
+    check_directories(out);
   }
 }
 

@@ -13,11 +13,19 @@
 #include <vector>
 
 #include "cli.h"
+#include "keyanim/offline/guarded_read.h"
 
 namespace keyanim::cli {
 
-// On SIGINT/SIGTERM/SIGHUP/SIGPIPE: remove the temporary outputs being written, then die.
+using Kind = offline::InputKind;  // what an input must be (guarded_read.h)
+
+// On SIGINT/SIGTERM/SIGHUP/SIGPIPE/SIGQUIT: remove the temporary outputs being written, then
+// die. SIGXFSZ (past `ulimit -f`) is ignored, so that the write fails and is reported.
 void install_interrupt_cleanup();
+
+// After a command that succeeded: everything it printed reached standard output (exit 4 if not:
+// a full disk, `>/dev/full`), so that lost output is never reported as success.
+void flush_standard_output();
 
 struct FileId {
   dev_t dev = 0;
@@ -27,9 +35,6 @@ struct FileId {
 // The identity of a regular file ("-": standard input), following symlinks; nothing for
 // anything else (a device, a pipe, a missing file), which cannot be lost by writing to it.
 std::optional<FileId> input_id(const std::string& path);
-
-// What a command reads; the first bytes decide, before the rest is read.
-enum class Kind { bvh, kanim, either };
 
 class Input {
  public:
@@ -82,6 +87,15 @@ class Output {
 
 // The identities of these inputs that are regular files.
 std::vector<FileId> ids_of(const std::vector<const Input*>& inputs);
+
+// Refuses (exit 4) `output` if it is one of `inputs` (for outputs that are appended to, such as
+// a report, which may exist).
+void check_not_input(const std::string& output, const std::vector<FileId>& inputs);
+
+// Refuses (exit 4) two different inputs whose outputs are one file: paths equal ignoring ASCII
+// case (as on case-insensitive file systems) once made lexically normal. The same input listed
+// twice is not a collision. `inputs[i]` is written to `outputs[i]`.
+void check_distinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
 
 // Before a run over many inputs: refuses (exit 4) outputs that two inputs would share (paths
 // equal ignoring ASCII case, as on case-insensitive file systems), outputs that are inputs,

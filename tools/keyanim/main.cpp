@@ -168,7 +168,9 @@ int main(int argc, char** argv) {
   install_interrupt_cleanup();
   Failure failure;
   try {
-    return run(argc, argv);
+    const int code = run(argc, argv);
+    flush_standard_output();  // a full standard output is a failure, whatever the code
+    return code;
   } catch (const Failure& f) {
     failure = f;
   } catch (const std::exception& e) {

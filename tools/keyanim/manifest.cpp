@@ -15,9 +15,12 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 #include "batch.h"
 #include "encode_one.h"
+#include "escape.h"
+#include "io.h"
 #include "keyanim/clip.h"
 
 namespace keyanim::cli {
@@ -73,7 +76,7 @@ class Report {
   }
   void add(const nlohmann::json& line) {
     if (fd_ < 0) return;
-    const std::string text = line.dump() + "\n";
+    const std::string text = json_text(line) + "\n";  // a name that is not UTF-8 keeps its line
     std::lock_guard<std::mutex> lock(mutex_);
     const ssize_t n = ::write(fd_, text.data(), text.size());
     if (n != ssize_t(text.size())) fail(kOutputFailed, path_ + ": cannot append to the report: " + std::strerror(errno));
@@ -86,8 +89,12 @@ class Report {
 };
 
 // Inputs already in the report as done (ok or skipped): a resumed run does not list them again.
+// Only a regular file is read back: a device or a FIFO (--report /dev/stdout) holds no earlier
+// run, and /dev/zero would be read without end.
 std::set<std::string> reported_done(const std::string& path) {
   std::set<std::string> done;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return done;
   std::ifstream in(path);
   for (std::string line; std::getline(in, line);) {
     const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);  // a torn last line is skipped
@@ -107,6 +114,36 @@ nlohmann::json noted_error(const Clip& clip) {
   const char* p = notes.data() + at + 10;
   const auto [end, ec] = std::from_chars(p, notes.data() + notes.size(), v);
   return ec == std::errc() ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+// The entries without the repeats of one (the first stays where it is): an input listed twice
+// is encoded once.
+std::vector<std::string> distinct(std::vector<std::string> entries) {
+  std::unordered_set<std::string_view> seen;  // views into `entries`, which stays put
+  std::vector<std::string> out;
+  for (const std::string& e : entries)
+    if (seen.insert(e).second) out.push_back(e);
+  return out;
+}
+
+// Before any work, over the whole list (so that every shard refuses it alike): two different
+// inputs with one output (m.bvh and m.BVH), or the report being one of the outputs.
+void check_manifest_outputs(const std::vector<std::string>& all, const std::string& outdir, const std::string& report) {
+  std::vector<std::string> inputs = all, outputs;
+  outputs.reserve(all.size() + 1);
+  for (const std::string& in : all) outputs.push_back(mirrored_output(in, outdir));
+  if (!report.empty()) inputs.push_back("--report"), outputs.push_back(report);
+  check_distinct(inputs, outputs);
+}
+
+// The report is appended to: it may exist, but it is never the list or one of this process's
+// inputs (appending a JSON line to a BVH file would break it).
+void check_report(const std::string& report, const std::string& list, const std::vector<std::string>& inputs) {
+  std::vector<FileId> ids;
+  if (auto id = input_id(list)) ids.push_back(*id);
+  for (const std::string& in : inputs)
+    if (auto id = input_id(in)) ids.push_back(*id);
+  check_not_input(report, ids);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -132,9 +169,13 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
     if (!in) fail(kBadInput, list + ": cannot open the list: " + std::strerror(errno));
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  const std::vector<std::string> all = manifest_entries(text);
+  const std::vector<std::string> all = distinct(manifest_entries(text));
+  check_manifest_outputs(all, outdir, report_path);
   std::vector<std::string> inputs;
-  for (uint64_t i = shard.index; i < all.size(); i += shard.count) inputs.push_back(all[size_t(i)]);
+  // (i + count could wrap around with a huge N and take every entry: step only while it fits.)
+  for (uint64_t i = shard.index; i < all.size(); i = all.size() - i > shard.count ? i + shard.count : all.size())
+    inputs.push_back(all[size_t(i)]);
+  if (!report_path.empty()) check_report(report_path, list, inputs);
   const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
   Report report(report_path);
 
@@ -151,6 +192,9 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
       std::error_code ec;
       Globals mine = quiet;
       if (skip_existing && fs::exists(out, ec)) {
+        // Only a regular file can be a finished output: a FIFO would never end the read, and a
+        // device is neither an output to keep nor one to replace.
+        if (!fs::is_regular_file(out, ec)) fail(kOutputFailed, out + ": is not a regular file; not an output of keyanim");
         Clip clip;
         if (Clip::load_file(out, clip) == Status::ok) {
           line.update({{"status", "skipped"}, {"bytes", fs::file_size(out, ec)}, {"max_error", noted_error(clip)},
@@ -160,6 +204,9 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
         }
         mine.force = true;  // damaged or incomplete: replaced
       }
+      // Another run on the same OUTDIR may finish this very output first: with --skip-existing
+      // that is no failure, and the rename replaces it, atomically, with an equal encoding.
+      if (skip_existing) mine.force = true;
       fs::create_directories(fs::path(out).parent_path(), ec);
       if (ec) fail(kOutputFailed, fs::path(out).parent_path().string() + ": cannot create: " + ec.message());
       const nlohmann::json r = encode_one(in, out, one, args.has("--error"), mine).summary;

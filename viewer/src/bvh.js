@@ -44,6 +44,12 @@ function number(tok, what) {
   return v;
 }
 
+// A whole, non-negative number, as keyanim reads counts (Frames: -3 or 2.5 is refused).
+function count(tok, what) {
+  if (!/^\+?\d+$/.test(tok.text) || !Number.isSafeInteger(Number(tok.text))) fail(tok, `expected ${what}, found '${tok.text}'`);
+  return Number(tok.text);
+}
+
 // The rest of a line after its first token: a name may contain spaces.
 const restOfLine = (line) => line.text.slice(line.tokens[0].column - 1 + line.tokens[0].text.length).trim();
 
@@ -60,13 +66,12 @@ function readOffset(lines) {
   return l.tokens.slice(1).map((t) => number(t, 'a number'));
 }
 
-// One ROOT/JOINT (its keyword line already read) or End Site, with its children, into nodes.
-function readNode(lines, head, parent, nodes, channelCount) {
+// One ROOT/JOINT/End Site node from its keyword line to its channels, into nodes.
+function startNode(lines, head, parent, nodes, channelCount) {
   const keyword = head.tokens[0].text;
   const endSite = keyword === 'End';
   if (endSite && head.tokens[1]?.text !== 'Site') fail(head.tokens[0], "expected 'End Site'");
   const name = endSite ? head.text.trim().replace(/^End\s+Site\s*/, '') : restOfLine(head);
-  const index = nodes.length;
   const node = { name, parent, offset: null, endSite, channels: [], firstChannel: channelCount.n };
   nodes.push(node);
   expectLine(lines, '{');
@@ -85,13 +90,22 @@ function readNode(lines, head, parent, nodes, channelCount) {
       channelCount.n += n;
     }
   }
-  for (;;) {
+  return { index: nodes.length - 1, endSite };
+}
+
+// A ROOT (its keyword line already read) and everything below it, into nodes. A loop over an
+// explicit stack of the nodes still open, not recursion: a chain as deep as keyanim accepts
+// (65536 nodes) would overflow the call stack.
+function readTree(lines, head, nodes, channelCount) {
+  const open = [startNode(lines, head, -1, nodes, channelCount)];
+  while (open.length > 0) {
+    const top = open[open.length - 1];
     const l = lines.next();
     if (!l) fail(lines.endPosition(), "expected '}', found the end of the file");
     const t = l.tokens[0].text;
-    if (t === '}') return;
-    if (endSite || (t !== 'JOINT' && t !== 'End')) fail(l.tokens[0], `expected ${endSite ? "'}'" : "JOINT, End Site or '}'"}, found '${t}'`);
-    readNode(lines, l, index, nodes, channelCount);
+    if (t === '}') { open.pop(); continue; }
+    if (top.endSite || (t !== 'JOINT' && t !== 'End')) fail(l.tokens[0], `expected ${top.endSite ? "'}'" : "JOINT, End Site or '}'"}, found '${t}'`);
+    open.push(startNode(lines, l, top.index, nodes, channelCount));
   }
 }
 
@@ -105,11 +119,11 @@ export function parseBvh(text) {
     if (!l) fail(lines.endPosition(), "expected ROOT or MOTION, found the end of the file");
     if (l.tokens[0].text === 'MOTION') break;
     if (l.tokens[0].text !== 'ROOT') fail(l.tokens[0], `expected ROOT or MOTION, found '${l.tokens[0].text}'`);
-    readNode(lines, l, -1, nodes, channelCount);
+    readTree(lines, l, nodes, channelCount);
   }
   if (nodes.length === 0) fail(lines.endPosition(), 'no ROOT in the hierarchy');
   const framesLine = expectLine(lines, 'Frames:');
-  const declared = number(framesLine.tokens[1] ?? framesLine.tokens[0], 'a frame count');
+  const declared = count(framesLine.tokens[1] ?? framesLine.tokens[0], 'a frame count');
   const timeLine = lines.next();
   if (!timeLine || timeLine.tokens[0].text !== 'Frame' || timeLine.tokens[1]?.text !== 'Time:') fail(timeLine ? timeLine.tokens[0] : lines.endPosition(), "expected 'Frame Time:'");
   const frameTime = number(timeLine.tokens[2] ?? timeLine.tokens[1], 'a frame time');

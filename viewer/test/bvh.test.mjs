@@ -26,3 +26,31 @@ test('BVH fixtures: the same verdicts as keyanim info', { skip }, () => {
   }
   assert.ok(rejected >= 5, `only ${rejected} fixtures rejected`);
 });
+
+// Issue 23: hostile BVH text. A chain as deep as the CLI encodes must not overflow the stack
+// (the reader once recursed per joint), and a frame count must be a whole number of frames.
+const chain = (n, frames = 'Frames: 2') => {
+  const out = ['HIERARCHY'];
+  for (let i = 0; i < n; ++i) out.push(`${i ? 'JOINT' : 'ROOT'} j${i}`, '{', 'OFFSET 0 1 0', 'CHANNELS 1 Zrotation');
+  out.push('End Site', '{', 'OFFSET 0 1 0', '}');
+  for (let i = 0; i < n; ++i) out.push('}');
+  out.push('MOTION', frames, 'Frame Time: 0.1', Array(n).fill('1').join(' '), Array(n).fill('2').join(' '));
+  return out.join('\n') + '\n';
+};
+
+test('an 8000-joint chain reads without overflowing the stack', () => {
+  const b = parseBvh(chain(8000));
+  assert.equal(b.nodes.length, 8001);
+  assert.equal(b.nodes[7999].parent, 7998);
+  assert.equal(b.nodes[8000].endSite, true);
+  assert.equal(b.channelCount, 8000);
+  assert.equal(b.frameCount, 2);
+});
+
+test('Frames: must be a whole, non-negative number', () => {
+  for (const bad of ['Frames: -3', 'Frames: 2.5', 'Frames: 1e30']) {
+    assert.throws(() => parseBvh(chain(2, bad)), /^Error|BvhError/, bad);
+    assert.throws(() => parseBvh(chain(2, bad)), (e) => e.name === 'BvhError' && /frame count/.test(e.message), bad);
+  }
+  assert.equal(parseBvh(chain(2, 'Frames: 2')).frameCount, 2);
+});

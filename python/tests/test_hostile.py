@@ -1,0 +1,152 @@
+"""What a careless or hostile caller does to the module (issue 23, round 2), one test per class
+of failure: outputs that destroy something, reads that never end, buffers that crash."""
+
+import os
+import stat
+import subprocess
+import sys
+import threading
+
+import pytest
+
+from conftest import WALK
+
+
+# Class 1: devices, FIFOs and links to them, and links to a standard stream, are written in
+# place, never renamed over.
+def test_write_bvh_to_a_fifo_or_a_link_to_a_device_writes_in_place(keyanim, walk, tmp_path):
+    fifo = tmp_path / "pipe.bvh"
+    os.mkfifo(fifo)
+    got = {}
+    reader = threading.Thread(target=lambda: got.update(data=open(fifo, "rb").read()), daemon=True)
+    reader.start()
+    walk.write_bvh(fifo, overwrite=True)
+    reader.join(20)
+    if reader.is_alive():  # nothing was written to the FIFO: let the reader go, if it is there
+        try:
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:
+            pass
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode), "the FIFO was replaced by a regular file"
+    walk.write_bvh(tmp_path / "file.bvh")
+    assert got["data"] == (tmp_path / "file.bvh").read_bytes()
+    os.unlink(tmp_path / "file.bvh")
+    link = tmp_path / "null.bvh"
+    link.symlink_to("/dev/null")
+    walk.write_bvh(link, overwrite=True)
+    assert link.is_symlink() and os.readlink(link) == "/dev/null"
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    assert sorted(os.listdir(tmp_path)) == ["null.bvh", "pipe.bvh"]  # no temporary file left
+
+
+def test_write_bvh_onto_a_device_node_keeps_it(keyanim, walk, tmp_path):
+    node = tmp_path / "null"
+    try:
+        os.mknod(node, stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    except PermissionError:
+        pytest.skip("creating a device node needs root")
+    walk.write_bvh(node, overwrite=True)
+    assert stat.S_ISCHR(os.lstat(node).st_mode), "the device node was replaced by a regular file"
+    with pytest.raises(FileExistsError):
+        walk.write_bvh(node)
+
+
+def test_write_bvh_to_a_link_to_standard_output(tmp_path):
+    # /dev/stdout is such a link (to /proc/self/fd/1); a private one, so that a failure cannot
+    # replace the system's.
+    link = tmp_path / "out.bvh"
+    link.symlink_to("/proc/self/fd/1")
+    code = "import keyanim; keyanim.read_bvh(%r).write_bvh(%r, overwrite=True)" % (str(WALK), str(link))
+    with open(tmp_path / "captured", "wb") as out:
+        subprocess.run([sys.executable, "-c", code], stdout=out, check=True, env=module_env())
+    assert link.is_symlink(), "the link to standard output was replaced"
+    assert (tmp_path / "captured").read_bytes().startswith(b"HIERARCHY")
+
+
+# Class 4: reads that never end go through the CLI's guards (refused by their first bytes).
+def module_env():
+    """The environment, with the module this test imported first on the path."""
+    import keyanim
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.path.dirname(os.path.dirname(os.path.abspath(keyanim.__file__)))
+    return env
+
+
+def run_bounded(code, tmp_path, seconds=30):
+    """Runs `code` in a fresh interpreter with a time limit and 4 GB of address space, so that a
+    regression fails the test instead of hanging it or exhausting the machine."""
+    script = "import resource; resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n" + code
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, errors="replace", timeout=seconds,
+                          env=module_env(), cwd=tmp_path)
+
+
+@pytest.mark.parametrize("call", ["keyanim.read_bvh('/dev/zero')", "keyanim.Clip('/dev/zero')",
+                                  "keyanim.read_bvh('/dev/urandom')", "keyanim.Clip('/dev/urandom')"])
+def test_endless_inputs_are_refused_by_their_first_bytes(call, tmp_path):
+    code = ("import keyanim\ntry:\n    %s\nexcept keyanim.Error as e:\n    print('refused:', e)\n" % call)
+    r = run_bounded(code, tmp_path)
+    assert r.returncode == 0 and r.stdout.startswith("refused: /dev/"), r.stdout + r.stderr
+    assert "signature" in r.stdout or "expected HIERARCHY" in r.stdout
+
+
+def test_dataset_leaves_out_a_fifo_named_like_a_clip(tmp_path):
+    os.mkfifo(tmp_path / "stuck.bvh")
+    os.symlink(WALK, tmp_path / "walk.bvh")
+    r = run_bounded("import keyanim\nprint(len(keyanim.Dataset('.', window=16).paths))", tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "1"
+    code = "import keyanim\ntry:\n    keyanim.Dataset(['stuck.bvh'])\nexcept keyanim.Error as e:\n    print(e)\n"
+    r = run_bounded(code, tmp_path)
+    assert r.stdout.strip() == "stuck.bvh: not a regular file", r.stdout + r.stderr
+
+
+def test_dataset_takes_a_bytes_path(keyanim, tmp_path):
+    os.symlink(WALK, tmp_path / "walk.bvh")
+    assert len(keyanim.Dataset(os.fsencode(tmp_path), window=16)) > 0
+
+
+# Class 2: a buffer that is not C-contiguous is copied in order, never read past its memory.
+def test_clip_from_a_strided_or_reversed_memoryview(keyanim, walk_encoded):
+    data = walk_encoded[0]
+    with pytest.raises(keyanim.Error, match="signature"):
+        keyanim.Clip(memoryview(data)[::-1])
+    spaced = bytes(b for byte in data for b in (byte, 0xAA))
+    clip = keyanim.Clip(memoryview(spaced)[::2])
+    assert clip.info["bytes"] == len(data)
+    assert clip.info == keyanim.Clip(data).info
+
+
+# Class 6: what cannot be read back is not written, and numpy integers are integers.
+def test_write_bvh_refuses_values_bvh_cannot_hold(keyanim, tmp_path):
+    m = keyanim.read_bvh(WALK)
+    view = m.channels
+    view[3, 7] = float("nan")
+    with pytest.raises(keyanim.Error, match="channel 7 of frame 3 is nan"):
+        m.write_bvh(tmp_path / "nan.bvh")
+    assert os.listdir(tmp_path) == []
+
+
+def test_to_motion_refuses_a_rate_whose_frame_time_is_infinite(keyanim, walk_clip):
+    for fps in (1e-320, 1e-309, float("inf"), 0.0, -1.0):
+        with pytest.raises(ValueError, match="fps"):
+            walk_clip.to_motion(fps=fps)
+    assert walk_clip.to_motion(fps=30.0).frame_count > 0
+
+
+def test_dataset_takes_numpy_integers(keyanim):
+    np = pytest.importorskip("numpy")
+    d = keyanim.Dataset([WALK], window=np.int64(16), stride=np.int32(8))
+    assert d.window == 16 and d.stride == 8 and len(d) > 0
+    for bad in (True, np.bool_(True), 2.0, 0):
+        with pytest.raises(ValueError, match="window must be an integer"):
+            keyanim.Dataset([WALK], window=bad)
+
+
+# Class 7: errors that say what happened.
+def test_encode_settings_out_of_range_say_so(keyanim, walk):
+    with pytest.raises(keyanim.Error, match="level is out of range"):
+        keyanim.encode(walk, level=2 ** 40)
+    with pytest.raises(TypeError, match="level must be an integer"):
+        keyanim.encode(walk, level=True)
+    with pytest.raises(keyanim.Error, match="threads is out of range"):
+        keyanim.encode(walk, threads=-2 ** 63 - 1)
