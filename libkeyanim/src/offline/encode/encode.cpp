@@ -203,7 +203,7 @@ void EncodeSettings::validate() const {
   if (shell_in_percent && shell > 100.0) invalid("shell distance in percent must be at most 100");
   if (uniform_interval < 1) invalid("uniform interval must be at least 1");
   if (!(tension >= -1.0f && tension <= 1.0f)) invalid("tension must be in [-1, 1]");
-  if (zstd_level < 1 || zstd_level > 22) invalid("zstd level must be in 1..22");
+  if (zstd_level && (*zstd_level < 1 || *zstd_level > 22)) invalid("zstd level must be in 1..22");
   if (key_mode == KeyMode::manual && manual_frames.empty()) invalid("manual key mode needs a list of frames");
 }
 
