@@ -98,7 +98,7 @@ py::tuple encode(const PyMotion& m, const py::object& error, const py::object& k
     py::gil_scoped_release unlocked;
     const auto t0 = std::chrono::steady_clock::now();
     result = offline::encode(m.motion, settings);
-    bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
+    bytes = offline::write_kanim(result.clip, settings.zstd_level);
     encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   py::dict report = to_python(offline::encode_summary("", "", m.motion, m.bvh_bytes.value_or(0), settings, result,

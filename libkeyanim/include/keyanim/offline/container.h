@@ -20,11 +20,9 @@ void validate_encoded_clip(const EncodedClip& clip);
 // zstd frame when that is smaller, else stored raw: without `zstd_level`, at the parameters
 // measured for that section (about -12 to -15: within 0.3% of -19's bytes on the test corpus
 // for a quarter of its instructions; container_writer.cpp); with one, at that level on every
-// section (clamped to at most zstd's maximum; <= 0 stores every section raw). Sections are
-// compressed on up to `threads` threads (0: one per core); the bytes do not depend on it.
-// Throws as validate_encoded_clip(clip).
-std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level = std::nullopt,
-                                 unsigned threads = 1);
+// section (clamped to at most zstd's maximum; <= 0 stores every section raw). One thread, one
+// zstd context at a time (memory). Throws as validate_encoded_clip(clip).
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level = std::nullopt);
 
 // The clip a decoder builds from write_kanim(clip), without the bytes: the encoder verifies
 // its error on this. Its arrays are identical to those Clip::load builds from the file.
