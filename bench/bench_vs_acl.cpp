@@ -348,7 +348,7 @@ double encode_keyanim(const Motion& m, ko::EncodeResult& encoded, std::vector<ui
   settings.threads = 1;
   const double t0 = cpu_ns();
   encoded = ko::encode(m, settings);
-  kanim = ko::write_kanim(encoded.clip, settings.zstd_level, 1);
+  kanim = ko::write_kanim(encoded.clip, settings.zstd_level);
   return cpu_ns() - t0;
 }
 

@@ -110,7 +110,7 @@ py::tuple encode(const PyMotion& m, const py::object& error, const py::object& k
     py::gil_scoped_release unlocked;
     const auto t0 = std::chrono::steady_clock::now();
     result = offline::encode(m.motion, settings);
-    bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
+    bytes = offline::write_kanim(result.clip, settings.zstd_level);
     encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   py::dict report = to_python(offline::encode_summary("", "", m.motion, m.bvh_bytes.value_or(0), settings, result,
@@ -139,8 +139,9 @@ void register_encode(py::module_& m) {
         "  instead of tolerance.\n"
         "settings: shell (as --shell: three points per joint at that distance along its local axes,\n"
         "  '2%' of the skeleton size by default, a str ending in % or a number of units; 0: joints\n"
-        "  and End Sites only), tension (in [-1, 1], default 0, or 'fit'), level (zstd, 1..22,\n"
-        "  default 19), threads (default 0: one per core; the bytes do not depend on it),\n"
+        "  and End Sites only), tension (in [-1, 1], default 0, or 'fit'), level (zstd, 1..22, on\n"
+        "  every section; default: each section at its measured parameters), threads (default 0:\n"
+        "  one per core; the bytes do not depend on it),\n"
         "  tangent_rule ('step_adjusted' or 'uniform'), allow_linear (default True), force_linear\n"
         "  (False). A motion with position channels below the root is kept within error under both\n"
         "  readings of them (replace and add).\n\n"

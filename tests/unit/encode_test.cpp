@@ -219,7 +219,7 @@ TEST_SUITE("encode") {
         s.tolerance = tol;
         s.threads = threads;
         EncodeResult r = encode(m, s);
-        const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level, threads);
+        const std::vector<uint8_t> bytes = write_kanim(r.clip, s.zstd_level);
         CAPTURE(threads);
         CAPTURE(tol);
         if (first.empty()) first = bytes;

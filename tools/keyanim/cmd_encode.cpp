@@ -72,7 +72,7 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   std::vector<double>().swap(motion.values);
   progress.compressing();
   // encode() made a clip the container can store: write_kanim cannot fail here.
-  const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level, settings.threads);
+  const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level);
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   Encoded e;
   e.summary = offline::encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);

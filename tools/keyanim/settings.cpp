@@ -25,7 +25,9 @@ std::string encoder_options_help(bool with_error) {
       "                        the error reached (and warn when it exceeds a given --error).\n"
       "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
       "                        least squares per channel, kept where it saves keys.\n"
-      "  --level N             zstd level, 1..22. Default 19.\n";
+      "  --level N             zstd level of every section, 1..22 (19: what keyanim 0.2 wrote).\n"
+      "                        Default: each section at the zstd parameters measured for it,\n"
+      "                        within 0.3% of -19's bytes for a quarter of its instructions.\n";
   return std::string(with_error ? error : "") + others;
 }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,7 +19,6 @@
 #include "keyanim/version.h"
 #include "runtime/clip_access.h"
 #include "internal/clip_source.h"
-#include "offline/parallel.h"
 
 namespace keyanim::offline {
 namespace {
@@ -165,22 +165,42 @@ struct Section {
   std::vector<uint8_t> stored;
 };
 
+// zstd's parameters for one section: a level, and a minimum match length (0: the level's).
+struct Zstd {
+  int level = 0;  // <= 0: stored raw
+  int min_match = 0;
+};
+
+// Without a level from the caller, each section at the cheapest parameters measured to keep
+// its bytes: over the 42 corpus files (0.05% / 0.5% of the skeleton size), against -19 on
+// every section (1,316,838 / 520,860 bytes) and counted by callgrind on CMU 01_01 and Bandai
+// walk_sad_002. zstd -19 (btultra2) cost 555 M instructions there, 15% of the encode, KTIM
+// 356 M and KVAL 181 M of them, for 0.5% fewer KTIM bytes than -15 and 0.75% fewer KVAL bytes
+// than -1. A minimum match of 6 bytes is both smaller and cheaper on the key sections (the
+// short matches of gaps and residual bytes cost more to code than they save). Per section:
+// KVAL -12, min match 6: +482 / -240 bytes, 181 M -> 20 M instructions (-9, min match 6:
+// +985 / -277, 13 M); KTIM -15, min match 6: +2,440 / -257, 356 M -> 114 M (-16: +1,091 /
+// -397, 163 M; -13: +13,065 / +1,210); SKEL and CHAN -15: +128 and +171 bytes, 17 M -> 9 M;
+// NOTE -15: -9 bytes. All five: +0.24% / -0.04% bytes for 139 M instructions instead of 555 M.
+constexpr Zstd kSkelZstd{15, 0}, kChanZstd{15, 0}, kKtimZstd{15, 6}, kKvalZstd{12, 6}, kNoteZstd{15, 0};
+
 // Compresses `raw` as one zstd frame, ending a zstd block at each of `breaks` (offsets) so
 // that streams of different statistics (the KVAL planes) get their own entropy tables.
-Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, int level,
+Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, Zstd z,
                      const std::vector<size_t>& breaks = {}) {
   Section sec;
   sec.tag = tag;
   sec.flags = flags;
   sec.raw_size = raw.size();
   if (!raw.empty() && cctx != nullptr) {
-    std::vector<uint8_t> z(ZSTD_compressBound(raw.size()) + 64 * (breaks.size() + 1));
+    std::vector<uint8_t> out_bytes(ZSTD_compressBound(raw.size()) + 64 * (breaks.size() + 1));
     ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, z.level);
+    if (z.min_match > 0) ZSTD_CCtx_setParameter(cctx, ZSTD_c_minMatch, z.min_match);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);  // the spec requires it
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);     // the file has its own CRC
     ZSTD_CCtx_setPledgedSrcSize(cctx, raw.size());
-    ZSTD_outBuffer out{z.data(), z.size(), 0};
+    ZSTD_outBuffer out{out_bytes.data(), out_bytes.size(), 0};
     bool ok = true;
     size_t from = 0;
     for (size_t k = 0; k <= breaks.size() && ok; ++k) {
@@ -196,8 +216,8 @@ Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZST
       from = to;
     }
     if (ok && out.pos < raw.size()) {
-      z.resize(out.pos);
-      sec.stored = std::move(z);
+      out_bytes.resize(out.pos);
+      sec.stored = std::move(out_bytes);
       sec.flags |= internal::kSectionCompressed;
       return sec;
     }
@@ -261,41 +281,49 @@ void validate_encoded_clip(const EncodedClip& clip) {
   if (std::string rule = first_broken_rule(clip); !rule.empty()) throw Error(ErrorKind::invalid_argument, rule);
 }
 
-std::vector<uint8_t> write_kanim(const EncodedClip& clip, int zstd_level, unsigned threads) {
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level) {
   validate_encoded_clip(clip);
   uint64_t keys = 0;
   for (const auto& c : clip.channels) keys += c.frames.size();
 
-  const int level = std::min(zstd_level, ZSTD_maxCLevel());
+  // A level from the caller: that level on every section, with zstd's own parameters for it.
+  auto zstd = [&](Zstd measured) {
+    return zstd_level ? Zstd{std::min(*zstd_level, ZSTD_maxCLevel()), 0} : measured;
+  };
   struct Raw {
     uint32_t tag, flags;
     std::vector<uint8_t> bytes;
-    bool compress;
+    Zstd z;
     std::vector<size_t> breaks;
   };
   std::vector<Raw> raw;
-  auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes, bool compress = true) {
-    raw.push_back({tag, flags, std::move(bytes), compress, {}});
+  auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes, Zstd z) {
+    raw.push_back({tag, flags, std::move(bytes), z, {}});
   };
-  add(internal::kTagClip, 0, clip_section(clip, keys), false);
-  add(internal::kTagSkel, 0, skel_section(clip.skeleton));
+  add(internal::kTagClip, 0, clip_section(clip, keys), Zstd{});  // 32 bytes: stored raw
+  add(internal::kTagSkel, 0, skel_section(clip.skeleton), zstd(kSkelZstd));
   const ValuePlan plan = plan_values(clip.channels);
-  add(internal::kTagChan, 0, chan_section(clip.channels, plan));
-  add(internal::kTagKtim, 0, ktim_section(clip.channels));
+  add(internal::kTagChan, 0, chan_section(clip.channels, plan), zstd(kChanZstd));
+  add(internal::kTagKtim, 0, ktim_section(clip.channels), zstd(kKtimZstd));
   // A block per plane: each gets its own entropy tables. (Also compressing without the
   // breaks and keeping the smaller won 0.005% on the CMU clips for a fifth of the encode.)
   std::vector<size_t> breaks;
-  add(internal::kTagKval, 0, kval_section(clip.channels, plan, breaks));
+  add(internal::kTagKval, 0, kval_section(clip.channels, plan, breaks), zstd(kKvalZstd));
   raw.back().breaks = std::move(breaks);
-  if (!clip.notes.empty()) add(internal::kTagNote, internal::kSectionAncillary, {clip.notes.begin(), clip.notes.end()});
-  // Sections are independent zstd frames: compressed on several threads, the bytes are the same.
+  if (!clip.notes.empty())
+    add(internal::kTagNote, internal::kSectionAncillary, {clip.notes.begin(), clip.notes.end()}, zstd(kNoteZstd));
+  // One section after another, in one zstd context: a context's tables at the higher levels
+  // are tens of MB, and two at once made the peak of `keyanim encode -j 2` on a 44,032-frame
+  // clip (120 MB against 99 MB with one; the encoder's own peak is 98 MB). KTIM is most of
+  // the compression's time, so threads gained little here.
   std::vector<Section> sections(raw.size());
-  parallel_for(raw.size(), threads, [&](size_t i, unsigned) {
-    // Null (level <= 0, or out of memory): the section is stored raw, still a valid file.
-    ZSTD_CCtx* cctx = level > 0 && raw[i].compress ? ZSTD_createCCtx() : nullptr;
-    sections[i] = make_section(raw[i].tag, raw[i].flags, std::move(raw[i].bytes), cctx, level, raw[i].breaks);
-    ZSTD_freeCCtx(cctx);
-  });
+  ZSTD_CCtx* cctx = nullptr;  // null (no level, or out of memory): stored raw, still a valid file
+  for (size_t i = 0; i < raw.size(); ++i) {
+    if (raw[i].z.level > 0 && cctx == nullptr) cctx = ZSTD_createCCtx();
+    sections[i] = make_section(raw[i].tag, raw[i].flags, std::move(raw[i].bytes), raw[i].z.level > 0 ? cctx : nullptr,
+                               raw[i].z, raw[i].breaks);
+  }
+  ZSTD_freeCCtx(cctx);
 
   std::vector<uint8_t> out;
   size_t total = internal::kHeaderEnd + internal::kTableEntrySize * sections.size() + internal::kChecksumSize;

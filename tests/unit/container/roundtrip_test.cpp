@@ -48,7 +48,8 @@ TEST_CASE("write then load equals to_clip bit-exactly") {
     CAPTURE(e.frame_count);
     REQUIRE_NOTHROW(keyanim::offline::validate_encoded_clip(e));
     const Clip ref = keyanim::offline::to_clip(e);
-    for (int level : {0, 3, 19}) {
+    for (std::optional<int> level : {std::optional<int>{}, std::optional<int>{0}, std::optional<int>{3},
+                                     std::optional<int>{19}}) {
       const auto bytes = keyanim::offline::write_kanim(e, level);
       REQUIRE(!bytes.empty());
       const Loaded l = load(bytes);
@@ -58,6 +59,49 @@ TEST_CASE("write then load equals to_clip bit-exactly") {
       CHECK(l.clip.version_major() == keyanim::kFormatVersionMajor);
       CHECK(l.clip.version_minor() == 0);
     }
+  }
+}
+
+// The stored frame of a section compressed alone at `level` (and `min_match`, 0: the level's),
+// as zstd's one-shot API makes it with the writer's frame options.
+std::vector<uint8_t> zstd_alone(const std::vector<uint8_t>& raw, int level, int min_match) {
+  ZSTD_CCtx* c = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(c, ZSTD_c_compressionLevel, level);
+  if (min_match > 0) ZSTD_CCtx_setParameter(c, ZSTD_c_minMatch, min_match);
+  ZSTD_CCtx_setParameter(c, ZSTD_c_checksumFlag, 0);
+  std::vector<uint8_t> z(ZSTD_compressBound(raw.size()));
+  const size_t n = ZSTD_compress2(c, z.data(), z.size(), raw.data(), raw.size());
+  ZSTD_freeCCtx(c);
+  REQUIRE(!ZSTD_isError(n));
+  z.resize(n);
+  return z;
+}
+
+TEST_CASE("zstd parameters: measured per section by default, a given level on every section") {
+  const EncodedClip e = random_clip(4, 3000, 20);  // sections large enough to compress
+  const RawFile by_section = split(keyanim::offline::write_kanim(e));
+  const RawFile at_3 = split(keyanim::offline::write_kanim(e, 3));
+  // The parameters container_writer.cpp documents; KVAL (zstd blocks per plane) is left out.
+  const std::map<std::string, std::pair<int, int>> measured = {
+      {"SKEL", {15, 0}}, {"CHAN", {15, 0}}, {"KTIM", {15, 6}}, {"NOTE", {15, 0}}};
+  REQUIRE(by_section.sections.size() == at_3.sections.size());
+  for (size_t i = 0; i < at_3.sections.size(); ++i) {
+    const RawSection& a = by_section.sections[i];
+    const RawSection& b = at_3.sections[i];
+    CAPTURE(a.tag);
+    REQUIRE(a.tag == b.tag);
+    if (!(a.flags & 1) || !(b.flags & 1)) continue;  // stored raw (CLIP; a section zstd cannot shrink)
+    std::vector<uint8_t> raw(a.raw_size), raw_b(b.raw_size);
+    REQUIRE(ZSTD_decompress(raw.data(), raw.size(), a.stored.data(), a.stored.size()) == raw.size());
+    REQUIRE(ZSTD_decompress(raw_b.data(), raw_b.size(), b.stored.data(), b.stored.size()) == raw_b.size());
+    CHECK(raw == raw_b);  // the level changes the frames only
+    if (a.tag == "KVAL") {
+      CHECK(a.stored != b.stored);
+      continue;
+    }
+    CHECK(b.stored == zstd_alone(raw, 3, 0));
+    const auto it = measured.find(a.tag);
+    if (it != measured.end()) CHECK(a.stored == zstd_alone(raw, it->second.first, it->second.second));
   }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,7 +43,8 @@ struct EncodeSettings {
   TangentRule tangent_rule = TangentRule::step_adjusted;  // Defaults to step-adjusted.
   bool allow_linear = true;                // Defaults to true: a channel may pick linear if cheaper.
   bool force_linear = false;               // Defaults to false. True: every channel linear (comparisons).
-  int zstd_level = 19;                     // Defaults to 19 (1..22).
+  std::optional<int> zstd_level;           // Defaults to none: each section at its measured
+                                           // parameters (write_kanim); a level (1..22): every section.
   uint32_t threads = 1;                    // Defaults to 1; 0: one per core. Output is the same.
   // Defaults to none. Called as encode() works: the stage and the fraction of it done, 0 to 1.
   // Error mode runs fitting and verifying in rounds until every joint is within the tolerance,
