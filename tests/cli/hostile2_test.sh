@@ -10,6 +10,8 @@
 #   report_names  a name that is not UTF-8 in a report keeps its line (and its bytes)
 #   wrong_results --shard with a huge N, two --skip-existing runs at once, an infinite frame time
 #   messages    errors that say what happened: tiny tolerances, an unreachable tolerance
+#   proportion  work in proportion to the input: a small BVH without channels declaring 2^24
+#               frames (every frame is the rest pose: one frame is measured for all)
 set -uo pipefail
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
@@ -213,6 +215,27 @@ messages)
   expect_rc 6 "$K" encode "$WALK" -o tiny.kanim --error 1e-30
   grep -q 'could not reach the tolerance' "$T/.stderr" || die "encode --error 1e-30: $(cat "$T/.stderr")"
   [ ! -e tiny.kanim ] || die "a failed encode left an output"
+  ;;
+proportion)
+  # 151 joints in a chain, no channels, Frames: 16777216: 121 KB of text. Every frame is the
+  # rest pose, so encode, render and eval cost what one frame does (before: past a minute each,
+  # and frame marks of 2^24 x 152 nodes); the clip keeps its declared frame count.
+  "$PY" - <<'PYEOF'
+lines = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 0"]
+for i in range(150):
+    lines += ["JOINT j%d" % i, "{", "OFFSET 0 1 0", "CHANNELS 0"]
+lines += ["End Site", "{", "OFFSET 0 1 0", "}"] + ["}"] * 151
+lines += ["MOTION", "Frames: 16777216", "Frame Time: 0.0083333", ""]
+open("still.bvh", "w").write("\n".join(lines))
+PYEOF
+  for cmd in "encode still.bvh -o still.kanim" "render still.bvh --frame 0 -o still.svg" "eval still.bvh" \
+             "verify still.kanim --against still.bvh --max-error 0.05%"; do
+    timeout 30 "$K" -q $cmd >/dev/null 2>&1
+    rc=$?
+    [ $rc = 0 ] || die "'keyanim $cmd' exited $rc (124: still running after 30 s)"
+  done
+  [ "$("$K" info still.kanim --json | "$PY" -c 'import json,sys; d=json.load(sys.stdin); print(d["frames"], d["keys"]["total"])')" = "16777216 0" ] ||
+    die "the clip does not keep its 2^24 frames without keys"
   ;;
 *) die "unknown case $CASE" ;;
 esac

@@ -194,16 +194,19 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded, double 
                                              "columns lie outside a frame");
   if (!(shell >= 0.0 && std::isfinite(shell)))
     throw Error(ErrorKind::invalid_argument, "the shell distance must be 0 or more and finite, got " + std::to_string(shell));
+  // Without channels every frame of both is the rest pose: frame 0 stands for all (and the
+  // work follows the input, not a declared frame count).
+  const uint32_t measured = channels == 0 ? std::min<uint32_t>(frames, 1) : frames;
   // Window by window, as a caller measuring in parallel does, so that both agree to the bit.
   ErrorAccumulator total(original.skeleton, shell, &decoded.skeleton);
-  const uint32_t window = measure_window(frames);
-  for (uint32_t first = 0; first < frames; first += window) {
+  const uint32_t window = measure_window(measured);
+  for (uint32_t first = 0; first < measured; first += window) {
     ErrorAccumulator part(original.skeleton, shell, &decoded.skeleton);
-    for (uint32_t f = first; f < std::min(frames, first + window); ++f)
+    for (uint32_t f = first; f < std::min(measured, first + window); ++f)
       part.add_frame(f, original.values.data() + size_t(f) * channels, decoded.values.data() + size_t(f) * channels);
     total.merge(part);
   }
-  return total.report(frames);
+  return total.report(measured);
 }
 
 }  // namespace keyanim::offline

@@ -225,8 +225,42 @@ void EncodeSettings::validate() const {
   if (key_mode == KeyMode::manual && manual_frames.empty()) invalid("manual key mode needs a list of frames");
 }
 
+namespace {
+
+// A motion without channels: every frame is the skeleton's rest pose, in the motion and in any
+// decode, so one frame holds all there is to fit and to measure. Encoded as one frame, then
+// given its frame count back: the work follows the input's size, not the count a small file
+// may declare (13 KB of BVH can declare 2^24 frames), and the bytes are what encoding every
+// frame gives (the same keys, none; the same error, 0 at frame 0; the same notes).
+EncodeResult encode_still(const Motion& m, const EncodeSettings& settings) {
+  if (!m.values.empty())
+    throw Error(ErrorKind::invalid_argument,
+                "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels");
+  EncodeSettings one_frame = settings;
+  if (settings.key_mode == KeyMode::manual) {
+    manual_keys(settings.manual_frames, m.frame_count);  // refused as for the whole motion
+    one_frame.manual_frames = {0};
+  }
+  Motion still;
+  still.skeleton = m.skeleton;
+  still.frame_count = 1;
+  still.frame_time = m.frame_time;
+  EncodeResult r = encode(still, one_frame);
+  r.clip.frame_count = m.frame_count;
+  r.clip.notes = encoder_notes(settings, r.tolerance_units, m.skeleton, r.error, r.iterations);
+  try {
+    validate_encoded_clip(r.clip);  // e.g. a frame time of 0 with several frames
+  } catch (const Error& e) {
+    throw Error(ErrorKind::malformed, "cannot be stored: " + e.message());
+  }
+  return r;
+}
+
+}  // namespace
+
 EncodeResult encode(const Motion& m, const EncodeSettings& settings) {
   settings.validate();
+  if (m.channel_count() == 0 && m.frame_count > 1) return encode_still(m, settings);
   const unsigned threads = resolve_threads(settings.threads);
   check_motion(m, threads);
   // Tolerance in file units. A skeleton with no extent (a lone root) falls back to its path.
