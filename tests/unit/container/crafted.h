@@ -118,6 +118,23 @@ inline std::vector<uint8_t> zstd_raw_frame(const std::vector<uint8_t>& content, 
   return z;
 }
 
+// A zstd frame of `size` bytes of `byte` made of RLE blocks of 128 KiB (4 bytes each): a few
+// KB that declare and can produce a large section (a zip bomb's shape).
+inline std::vector<uint8_t> zstd_rle_frame(uint64_t size, uint8_t byte) {
+  std::vector<uint8_t> z = {0x28, 0xB5, 0x2F, 0xFD, 0xE0};  // FHD: single segment, 8-byte FCS
+  for (int k = 0; k < 8; ++k) z.push_back(uint8_t(size >> (8 * k)));
+  for (uint64_t done = 0; done < size;) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(size - done, 128 * 1024));
+    done += n;
+    const uint32_t header = (done == size ? 1u : 0u) | (1u << 1) | (n << 3);  // RLE
+    z.push_back(uint8_t(header));
+    z.push_back(uint8_t(header >> 8));
+    z.push_back(uint8_t(header >> 16));
+    z.push_back(byte);
+  }
+  return z;
+}
+
 struct Loaded {
   Status status;
   ErrorInfo err;

@@ -343,6 +343,18 @@ TEST_CASE("crafted zstd frames") {
   CHECK_FAILS(compressed_clip(zstd_raw_frame(clip_raw, 31), 32), Status::zstd_error, clip);  // declared != raw
   CHECK_FAILS(compressed_clip(zstd_raw_frame(clip_raw, 32), 31), Status::zstd_error, clip);
   CHECK_FAILS(compressed_clip(clip_raw, 32), Status::zstd_error, clip);  // not a frame
+  // A section whose declared size its parse must refuse is refused before it is inflated: a
+  // CLIP of 1000 MiB from 32 KB of RLE blocks (the loader used to allocate and inflate it).
+  CHECK_FAILS(compressed_clip(zstd_rle_frame(1000ull << 20, 0), 1000ull << 20), Status::corrupt, clip);
+  {
+    RawFile r = base;  // a KTIM of more than 5 bytes a key, compressed
+    RawSection& ktim = r.get("KTIM");
+    const uint64_t raw = 64ull << 20;
+    ktim.flags = 1, ktim.stored = zstd_rle_frame(raw, 0), ktim.raw_size = raw;
+    CHECK_FAILS(r.build(), Status::corrupt, r.offset_of("KTIM"));
+    // Said from its declared size (inflated, its zeros would fail later, as other faults).
+    CHECK(load(r.build()).err.detail.find("longer than Key_Count varints") != std::string::npos);
+  }
   {
     auto two = zstd_raw_frame(clip_raw, 32);
     two.push_back(0);  // a byte after the frame

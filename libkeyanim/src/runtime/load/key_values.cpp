@@ -154,18 +154,24 @@ constexpr DecodeKeys kDecodeKeys[kMaxResidualBytes + 1] = {decode_keys<0>, decod
 
 }  // namespace
 
+uint64_t Loader::kval_fixed_bytes(const ClipSource& parts) const noexcept {
+  uint64_t total = 0;  // < 2^28 keys x 8 bytes
+  for (size_t ch = 0; ch < parts.channels.size(); ++ch) total += uint64_t(parts.channels[ch].key_count) * residual_bytes_[ch];
+  return total;
+}
+
 Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
   // Plane k: byte k of every residual of the channels with Residual_Bytes > k (section 4.5).
   const size_t channels = parts.channels.size();
   uint64_t size[internal::kMaxResidualBytes] = {};
   for (size_t ch = 0; ch < channels; ++ch)
     for (uint32_t k = 0; k < residual_bytes_[ch]; ++k) size[k] += parts.channels[ch].key_count;
-  uint64_t total = 0;
   size_t at[internal::kMaxResidualBytes];  // where each plane's next byte is
+  uint64_t total = 0;
   for (uint32_t k = 0; k < internal::kMaxResidualBytes; ++k) at[k] = static_cast<size_t>(total), total += size[k];
   if (total != c.size)
     return fail_in(Status::corrupt, c, 0,
-                   "KVAL must hold " + std::to_string(total) + " bytes (the channels' keys times their Residual_Bytes)");
+                   "KVAL must hold " + std::to_string(kval_fixed_bytes(parts)) + " bytes (the channels' keys times their Residual_Bytes)");
   parts.q.resize(static_cast<size_t>(key_count_));
   for (size_t ch = 0; ch < channels; ++ch) {
     const internal::SourceChannel& t = parts.channels[ch];

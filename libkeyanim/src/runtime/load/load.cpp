@@ -32,12 +32,12 @@ Status Loader::run(ClipSource& parts) {
       for (int k = 0; k < 5; ++k) {
         if (critical_index_[k] != static_cast<int>(i)) continue;
         switch (k) {
-          case 0: s = get_content(e, "CLIP", c); if (s == Status::ok) s = parse_clip(c, parts); break;
-          case 1: s = get_content(e, "SKEL", c); if (s == Status::ok) s = parse_skel(c, parts); break;
-          case 2: s = get_content(e, "CHAN", c); if (s == Status::ok) s = parse_chan(c, parts); break;
-          case 3: s = get_content(e, "KTIM", c); if (s == Status::ok) s = parse_ktim(c, parts); break;
+          case 0: s = get_content(e, "CLIP", c, 0, &parts); if (s == Status::ok) s = parse_clip(c, parts); break;
+          case 1: s = get_content(e, "SKEL", c, 1, &parts); if (s == Status::ok) s = parse_skel(c, parts); break;
+          case 2: s = get_content(e, "CHAN", c, 2, &parts); if (s == Status::ok) s = parse_chan(c, parts); break;
+          case 3: s = get_content(e, "KTIM", c, 3, &parts); if (s == Status::ok) s = parse_ktim(c, parts); break;
           default:
-            s = get_content(e, "KVAL", c);
+            s = get_content(e, "KVAL", c, 4, &parts);
             if (s == Status::ok) s = major_ >= 3 ? parse_kval_fixed(c, parts) : parse_kval(c, parts);
             break;
         }

@@ -68,7 +68,17 @@ class Loader {
   }
 
   Status read_header_and_table();
-  Status get_content(const TableEntry& e, const char* name, Content& out);
+  // `critical` (0..4, CLIP..KVAL; -1 for NOTE) bounds a compressed section's Raw_Size by
+  // check_declared_size once its zstd frame header is checked, before it is inflated.
+  Status get_content(const TableEntry& e, const char* name, Content& out, int critical = -1,
+                     const ClipSource* parts = nullptr);
+  // Before a compressed critical section is inflated (get_content): its Raw_Size against what the sections
+  // before it fix (CLIP 32 bytes, SKEL and KTIM at least a record or a byte per node or key,
+  // KTIM at most 5 bytes a key, CHAN and 3.x KVAL exactly), failing as the parse of the
+  // inflated content would: a declared size cannot make the loader inflate what it then refuses.
+  Status check_declared_size(const TableEntry& e, int critical, const ClipSource& parts);
+  // KVAL's size in 3.x: each channel's keys times its Residual_Bytes (CHAN parsed).
+  uint64_t kval_fixed_bytes(const ClipSource& parts) const noexcept;
   Status parse_clip(const Content& c, ClipSource& parts);
   Status parse_skel(const Content& c, ClipSource& parts);
   Status parse_chan(const Content& c, ClipSource& parts);

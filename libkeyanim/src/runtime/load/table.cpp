@@ -9,6 +9,7 @@
 
 #include "internal/byte_reader.h"
 #include "internal/format.h"
+#include "internal/varint.h"
 #include "internal/zstd_bound.h"
 #include "keyanim/version.h"
 #include "runtime/load/loader.h"
@@ -128,7 +129,7 @@ Status Loader::read_header_and_table() {
   return Status::ok;
 }
 
-Status Loader::get_content(const TableEntry& e, const char* name, Content& out) {
+Status Loader::get_content(const TableEntry& e, const char* name, Content& out, int critical, const ClipSource* parts) {
   out.name = name;
   out.file_offset = e.file_offset;
   const uint8_t* src = bytes_.data() + e.file_offset;
@@ -160,6 +161,8 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out) 
     return fail(Status::zstd_error, name, e.file_offset,
                 "the zstd frame's blocks can produce at most " + std::to_string(*bound) + " bytes, Raw_Size is " +
                     std::to_string(e.raw));
+  if (critical >= 0 && parts != nullptr)
+    if (Status s = check_declared_size(e, critical, *parts); s != Status::ok) return s;
   if (!dctx_) {
     dctx_.reset(ZSTD_createDCtx());
     if (!dctx_) return fail(Status::zstd_error, name, e.file_offset, "cannot create a zstd context");
@@ -172,6 +175,44 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out) 
   if (got != e.raw) return fail(Status::zstd_error, name, e.file_offset, "the zstd frame decompressed to the wrong size");
   out.data = buf;
   out.size = got;
+  return Status::ok;
+}
+
+Status Loader::check_declared_size(const TableEntry& e, int critical, const ClipSource& parts) {
+  if (!(e.flags & kSectionCompressed)) return Status::ok;  // nothing to inflate: the parse checks
+  static const char* const kNames[5] = {"CLIP", "SKEL", "CHAN", "KTIM", "KVAL"};
+  Content c;  // where a failure is reported: the section's stored bytes, as after inflating
+  c.name = kNames[critical];
+  c.file_offset = e.file_offset;
+  c.compressed = true;
+  const uint64_t raw = e.raw;
+  switch (critical) {
+    case 0:
+      if (raw != kClipSize) return fail_in(Status::corrupt, c, 0, "CLIP must be 32 bytes, not " + std::to_string(raw));
+      break;
+    case 1:
+      if (node_count_ > raw / kNodeFixedBytes)
+        return fail_in(Status::corrupt, c, 0, "SKEL is too short for " + std::to_string(node_count_) + " nodes");
+      break;
+    case 2: {
+      const uint64_t per = major_ >= 3 ? kChanBytesPerChannel : major_ == 2 ? kChanBytesPerChannelV2 : kChanBytesPerChannelV1;
+      if (raw != uint64_t(channel_count_) * per)
+        return fail_in(Status::corrupt, c, 0, "CHAN must be " + std::to_string(per) + " x Channel_Count bytes");
+      break;
+    }
+    case 3:
+      if (key_count_ > raw) return fail_in(Status::corrupt, c, 0, "KTIM is too short for Key_Count varints");
+      if (raw > key_count_ * kMaxVarint32Bytes)
+        return fail_in(Status::corrupt, c, 0, "KTIM is longer than Key_Count varints of at most 5 bytes can be");
+      break;
+    default:
+      if (major_ >= 3 && raw != kval_fixed_bytes(parts))
+        return fail_in(Status::corrupt, c, 0, "KVAL must hold " + std::to_string(kval_fixed_bytes(parts)) +
+                                                   " bytes (the channels' keys times their Residual_Bytes)");
+      if (major_ < 3 && raw > 1 + 4 * uint64_t(kMaxVarint64Bytes) + key_count_ * kMaxVarint64Bytes)
+        return fail_in(Status::corrupt, c, 0, "KVAL is longer than Key_Count varints of at most 10 bytes can be");
+      break;
+  }
   return Status::ok;
 }
 
