@@ -64,6 +64,7 @@ fuzz() {
   local t=$1 work=$B/fuzz-work/$1 found=$B/findings/$1 log=$B/fuzz_$1.log
   rm -rf "$work"; mkdir -p "$work" "$found"
   cp fuzz/corpus/"$t"/* "$work"/
+  [ "$t" != c_api ] || cp fuzz/corpus/sample/* "$work"/  # fuzz_c_api reads fuzz_sample's inputs too
   local dict=()
   case $t in bvh|roundtrip) dict=(-dict=fuzz/bvh.dict) ;; esac
   # A fixed seed keeps CI reproducible; long exploratory runs are local (fuzz/README.md).
@@ -77,7 +78,7 @@ fuzz() {
 }
 # One target per core.
 status=0
-for pair in "bvh load" "sample roundtrip"; do
+for pair in "bvh load" "sample roundtrip" "c_api"; do
   pids=()
   for t in $pair; do fuzz "$t" & pids+=($!); done
   for p in "${pids[@]}"; do wait "$p" || status=1; done

@@ -206,9 +206,12 @@ KEYANIM_C_API const char* keyanim_clip_node_name(const keyanim_clip* clip, uint3
 KEYANIM_C_API int32_t keyanim_clip_node_parent(const keyanim_clip* clip, uint32_t node);
 
 KEYANIM_C_API uint32_t keyanim_skeleton_node_count(const keyanim_skeleton* skeleton);
-/* The name as the BVH file spelled it (NUL-terminated; "" for an unnamed End Site); NULL for
- * a node out of range. A name holds no NUL byte. */
+/* The name as the BVH file spelled it, NUL-terminated ("" for an unnamed End Site); NULL for a
+ * node out of range. Names are bytes (UTF-8 when the encoder followed the spec's advice) and
+ * may hold any byte, even NUL, since the format lets no decoder refuse one: _name_length is
+ * the whole name's length in bytes, of which a C string shows the part before a NUL. */
 KEYANIM_C_API const char* keyanim_skeleton_node_name(const keyanim_skeleton* skeleton, uint32_t node);
+KEYANIM_C_API uint32_t keyanim_skeleton_node_name_length(const keyanim_skeleton* skeleton, uint32_t node);
 /* The parent's index (< node), -1 for a root, KEYANIM_NO_NODE out of range. */
 KEYANIM_C_API int32_t keyanim_skeleton_node_parent(const keyanim_skeleton* skeleton, uint32_t node);
 /* 1 for an End Site (no channels), 0 for a joint or out of range. */

@@ -138,6 +138,8 @@ static void bad_nodes(const keyanim_clip* clip) {
   char order[4];
   CHECK(keyanim_clip_node_name(clip, n) == NULL && keyanim_clip_node_parent(clip, n) == KEYANIM_NO_NODE);
   CHECK(keyanim_skeleton_node_is_end_site(sk, n) == 0 && keyanim_skeleton_node_channel_count(sk, n) == 0);
+  CHECK(keyanim_skeleton_node_name_length(sk, 0) == 4 && strcmp(keyanim_clip_node_name(clip, 0), "Hips") == 0);
+  CHECK(keyanim_skeleton_node_name_length(sk, n) == 0);
   CHECK(keyanim_skeleton_node_offset(sk, n, offset) == KEYANIM_INVALID_ARGUMENT);
   CHECK(keyanim_skeleton_node_offset(sk, 0, NULL) == KEYANIM_INVALID_ARGUMENT);
   CHECK(keyanim_skeleton_node_channel_types(sk, 0, types, 2) == KEYANIM_OUTPUT_TOO_SMALL); /* the root has 6 */

@@ -33,6 +33,10 @@ const char* keyanim_skeleton_node_name(const keyanim_skeleton* s, uint32_t node)
   const Joint* j = node_of(s, node, "keyanim_skeleton_node_name");
   return j ? j->name.c_str() : nullptr;
 }
+uint32_t keyanim_skeleton_node_name_length(const keyanim_skeleton* s, uint32_t node) {
+  const Joint* j = node_of(s, node, "keyanim_skeleton_node_name_length");
+  return j ? static_cast<uint32_t>(j->name.size()) : 0;  // SKEL's Name_Length is a u32
+}
 int32_t keyanim_skeleton_node_parent(const keyanim_skeleton* s, uint32_t node) {
   const Joint* j = node_of(s, node, "keyanim_skeleton_node_parent");
   return j ? j->parent : KEYANIM_NO_NODE;
