@@ -41,6 +41,13 @@
  *   KEYANIM_OUTPUT_TOO_SMALL and is left unchanged; a larger one is fine (the rest untouched).
  *   Sampling never allocates. With a cursor, forward playback is faster; the values are the
  *   same bit for bit.
+ *
+ * NOT YET
+ *   Every load validates the bytes and builds the clip's own image from them (which is why the
+ *   bytes need not outlive the call). Viewing bytes the caller keeps without that copy
+ *   (keyanim_clip_view), banks of clips, and a skeleton handle shared by every clip of a rig
+ *   wait for the runtime profile of the format; a keyanim_skeleton is today one clip's,
+ *   borrowed from it.
  */
 #ifndef KEYANIM_C_H
 #define KEYANIM_C_H
