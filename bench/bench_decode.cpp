@@ -11,6 +11,10 @@
 //   cold_pose_ns        one random pose with the clip's whole image flushed (clflush) first,
 //                       against cold_raw_copy_ns, a raw pose copy with its row flushed first
 //   load_mb_s           file bytes per second through Clip::load (validation included)
+//   c_api_local_ns      keyanim_clip_sample_local (the C API, libkeyanim_c.so) at the same
+//                       positions, in the same rounds as clip_local_ns (Clip::sample_local,
+//                       = random_local_ns); c_api_over_clip_local: the median of the rounds'
+//                       ratios (issue 26's target: at most 1.05)
 // With --all, the same for every CMU 120 fps file of the corpus, with the bytes ACL needs at
 // the error keyanim reached under the shell metric (../shared/anchors/acl_shell.tsv,
 // interpolated log-log as keyanim eval --acl does).
@@ -33,6 +37,9 @@
 #include <nlohmann/json.hpp>
 
 #include "keyanim/clip.h"
+#if KEYANIM_BENCH_C_API
+#include "keyanim.h"
+#endif
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
@@ -164,7 +171,12 @@ nlohmann::json measure(const Motion& m, bool speed) {
   std::vector<keyanim::Transform> xf(clip.skeleton().joints.size());
   keyanim::Cursor cursor;
   cursor.prepare(clip);
-  std::vector<double> copy, rnd, local, seq;
+  std::vector<double> copy, rnd, local, seq, c_local, c_ratio;
+#if KEYANIM_BENCH_C_API
+  keyanim_clip* handle = nullptr;
+  if (keyanim_clip_load(bytes.data(), bytes.size(), &handle) != KEYANIM_OK) return {{"error", "C API load failed"}};
+  std::vector<keyanim_transform> cxf(xf.size());
+#endif
   for (int r = 0; r < 9; ++r) {  // interleaved rounds: drifts hit every figure alike
     copy.push_back(batch_ns([&] {
       for (size_t i = 0; i < poses; ++i) {
@@ -184,6 +196,15 @@ nlohmann::json measure(const Motion& m, bool speed) {
         g_sink = g_sink + xf[i % xf.size()].rotation[0];
       }
     }) / poses);
+#if KEYANIM_BENCH_C_API
+    c_local.push_back(batch_ns([&] {
+      for (size_t i = 0; i < poses; ++i) {
+        keyanim_clip_sample_local(handle, pos[i], cxf.data(), cxf.size());
+        g_sink = g_sink + cxf[i % cxf.size()].rotation[0];
+      }
+    }) / poses);
+    c_ratio.push_back(c_local.back() / local.back());
+#endif
     seq.push_back(batch_ns([&] {
       for (size_t i = 0; i < poses; ++i) {
         clip.sample(double(i % F), out, &cursor);  // playback at the clip's rate, looping
@@ -218,6 +239,12 @@ nlohmann::json measure(const Motion& m, bool speed) {
   j["random_local_x_copy"] = median(local) / c;
   j["sequential_pose_x_copy"] = median(seq) / c;
   j["cold_pose_x_copy"] = median(cold) / median(cold_copy);
+#if KEYANIM_BENCH_C_API
+  keyanim_clip_free(handle);
+  j["clip_local_ns"] = median(local);
+  j["c_api_local_ns"] = median(c_local);
+  j["c_api_over_clip_local"] = median(c_ratio);
+#endif
   return j;
 }
 
@@ -246,7 +273,7 @@ int main(int argc, char** argv) {
   j["file"] = path;
   j["targets"] = {{"memory_over_file", 2}, {"random_pose_x_copy", 30}, {"random_local_x_copy", 40},
                   {"sequential_pose_x_copy", 20}, {"cold_pose_x_copy", 5}, {"load_mb_s", 300},
-                  {"memory_over_acl", 1}};
+                  {"memory_over_acl", 1}, {"c_api_over_clip_local", 1.05}};
   if (all) {
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(fs::path(KEYANIM_CORPUS_DIR) / "cmu")) files.push_back(e.path());

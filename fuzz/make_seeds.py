@@ -7,7 +7,9 @@ usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
  - roundtrip/: a settings byte + BVH snippets of at most 2000 values (see fuzz_roundtrip.cpp)
  - load/:      spec/test-vectors/*.kanim and .kanim files encoded (by KEYANIM_BINARY) from snippets,
                each also with its sections stored uncompressed (zstd CLI)
- - sample/:    request records + those .kanim files (see fuzz_sample.cpp)
+ - sample/:    request records + those .kanim files (see fuzz_sample.cpp); fuzz_c_api reads them too
+ - c_api/:     c_api_seeds(): a few of sample/'s seeds with every fuzz_c_api request kind, loaded
+               with the CRC-32 as given (byte 0 >= 231): intact, a byte flipped, cut short
 
 Only CMU clips are used from the shared corpus (their terms allow it); never bandai/ or ManipNet.
 Crash inputs found later are added by hand as crash-<what>.* files and never regenerated.
@@ -128,6 +130,25 @@ def main() -> None:
             m = rng.randrange(256) if mode >= 8 else mode | (rng.randrange(8) << 3) | (rng.randrange(2) << 6)
             records += bytes([m]) + struct.pack("<d", rng.uniform(-5, 60))
         write(os.path.join(corpus, "sample", key + ".bin"), bytes([16]) + records + data)
+    c_api_seeds(corpus)
+
+
+def c_api_seeds(corpus):
+    """fuzz_c_api's own seeds, made from sample/'s: 24 requests (byte 0 = 255: 255 % 33 = 24,
+    and >= 231, so that the CRC-32 is kept) of every kind (channels, local, model; by frame or
+    time; cursor; short buffer; each way of making a position), on the file as it is, with a
+    byte flipped and cut short."""
+    rng = random.Random(26)
+    for key in ("vector_v3_rules", "data_cmu_02_01_walk_coarse", "data_cmu_131_03_hop_coarse_raw"):
+        with open(os.path.join(corpus, "sample", key + ".bin"), "rb") as f:
+            seed = f.read()
+        data = seed[1 + 16 * 9:]
+        modes = [(p << 5) | ((p * 3 + k * 11) % 32) for p in range(8) for k in range(3)]
+        records = b"".join(bytes([m]) + struct.pack("<d", rng.uniform(-5, 60)) for m in modes)
+        flipped = bytearray(data)
+        flipped[len(data) // 2] ^= 0x10
+        for label, body in (("", data), ("_flipped", bytes(flipped)), ("_cut", data[:len(data) * 2 // 3])):
+            write(os.path.join(corpus, "c_api", "crc_kept_" + key + label + ".bin"), bytes([255]) + records + body)
 
 
 if __name__ == "__main__":

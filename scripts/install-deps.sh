@@ -22,6 +22,7 @@ REQUIRED=(
   # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
   # matplotlib for examples/plot_channel.py.
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
+  mono-mcs mono-runtime  # tests/capi: the C API from C# (examples/csharp/), compiled by mcs, run by mono
 )
 # For scripts/sanitize.sh's fuzz step and the clang build of the tests: clang with libFuzzer.
 # The runtime's package name differs (Debian 12: libclang-rt-14-dev; Ubuntu 24.04:

@@ -21,11 +21,13 @@ EXCLUDE=${KEYANIM_ASAN_EXCLUDE-^gltf_(corpus|blender)}
 B=build-asan
 
 CXX_FOR_ASAN=g++
+CC_FOR_ASAN=gcc  # the C API's C programs (examples/c, tests/capi): the same compiler family
 FUZZ=OFF
 if command -v clang++ >/dev/null &&
    echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' |
      clang++ -x c++ -fsanitize=fuzzer,address,undefined - -o /dev/null 2>/dev/null; then
   CXX_FOR_ASAN=clang++
+  CC_FOR_ASAN=clang
   FUZZ=ON
 else
   echo "sanitize: clang++ with libFuzzer not found (install clang and libclang-rt-14-dev): GCC, no fuzzing"
@@ -40,7 +42,7 @@ start=$(date +%s)
 # -O1: fast enough to run everything, while keeping stack traces readable.
 # With clang, this is also the build that keeps clang's warnings out (KEYANIM_WERROR, as build/
 # does for GCC).
-scripts/configure.sh "$B" -DCMAKE_CXX_COMPILER="$CXX_FOR_ASAN" \
+scripts/configure.sh "$B" -DCMAKE_CXX_COMPILER="$CXX_FOR_ASAN" -DCMAKE_C_COMPILER="$CC_FOR_ASAN" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
   -DKEYANIM_SANITIZE=address,undefined -DKEYANIM_BUILD_FUZZ=$FUZZ -DKEYANIM_BUILD_BENCH=ON \
   -DKEYANIM_BUILD_VIEWER=OFF -DKEYANIM_BUILD_PYTHON=OFF  # JavaScript and Python: tested in build/
@@ -64,6 +66,7 @@ fuzz() {
   local t=$1 work=$B/fuzz-work/$1 found=$B/findings/$1 log=$B/fuzz_$1.log
   rm -rf "$work"; mkdir -p "$work" "$found"
   cp fuzz/corpus/"$t"/* "$work"/
+  [ "$t" != c_api ] || cp fuzz/corpus/sample/* "$work"/  # fuzz_c_api reads fuzz_sample's inputs too
   local dict=()
   case $t in bvh|roundtrip) dict=(-dict=fuzz/bvh.dict) ;; esac
   # A fixed seed keeps CI reproducible; long exploratory runs are local (fuzz/README.md).
@@ -77,7 +80,7 @@ fuzz() {
 }
 # One target per core.
 status=0
-for pair in "bvh load" "sample roundtrip"; do
+for pair in "bvh load" "sample roundtrip" "c_api"; do
   pids=()
   for t in $pair; do fuzz "$t" & pids+=($!); done
   for p in "${pids[@]}"; do wait "$p" || status=1; done

@@ -8,8 +8,9 @@
 Rules:
   1. Nothing outside tools/ includes a file of tools/, and no CMake file outside tools/ compiles
      a source of tools/ or adds one of its folders to an include path.
-  2. The runtime (libkeyanim/include/keyanim/*.h, libkeyanim/src/runtime/, and
-     libkeyanim/src/internal/, which the runtime includes) never includes an offline header
+  2. The runtime (libkeyanim/include/keyanim/*.h, libkeyanim/src/runtime/,
+     libkeyanim/src/internal/, which the runtime includes, and the C API over it:
+     libkeyanim/include/keyanim.h and libkeyanim/src/c_api/) never includes an offline header
      (keyanim/offline/... or src/offline/...), and the keyanim_runtime target lists no offline
      source.
   3. README.md's layout table matches the tree: every path it names exists, and every folder at
@@ -27,7 +28,8 @@ import tempfile
 
 SOURCE_EXT = (".c", ".cc", ".cpp", ".h", ".hpp")
 INCLUDE_ROOTS = ("libkeyanim/include", "libkeyanim/src", "tests")
-RUNTIME_PREFIXES = ("libkeyanim/src/runtime/", "libkeyanim/src/internal/")
+RUNTIME_PREFIXES = ("libkeyanim/src/runtime/", "libkeyanim/src/internal/", "libkeyanim/src/c_api/")
+RUNTIME_FILES = ("libkeyanim/include/keyanim.h",)  # the C API's header
 INCLUDE_RE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 
 
@@ -45,7 +47,7 @@ def tracked_files(repo):
 
 
 def is_runtime(path):
-    if path.startswith(RUNTIME_PREFIXES):
+    if path.startswith(RUNTIME_PREFIXES) or path in RUNTIME_FILES:
         return True
     return path.startswith("libkeyanim/include/keyanim/") and path.count("/") == 3
 
@@ -141,6 +143,8 @@ def self_test():
         "libkeyanim/include/keyanim/offline/bvh.h": '#include "keyanim/clip.h"\n',
         "libkeyanim/src/runtime/load.cpp": '#include "keyanim/clip.h"\n#include "internal/format.h"\n',
         "libkeyanim/src/internal/format.h": "",
+        "libkeyanim/include/keyanim.h": "",
+        "libkeyanim/src/c_api/sample.cpp": '#include "keyanim.h"\n#include "keyanim/clip.h"\n',
         "libkeyanim/src/offline/encode.cpp": '#include "keyanim/offline/bvh.h"\n',
         "libkeyanim/CMakeLists.txt": "add_library(keyanim_runtime src/runtime/load.cpp)\n",
         "tools/keyanim/io.h": "",
@@ -158,6 +162,8 @@ def self_test():
         "a runtime source including an offline header": ("libkeyanim/src/runtime/load.cpp", '#include "keyanim/offline/bvh.h"\n'),
         "a runtime public header including offline": ("libkeyanim/include/keyanim/clip.h", '#include "offline/encode/verify.h"\n'),
         "an internal header including offline": ("libkeyanim/src/internal/format.h", '#include "keyanim/offline/bvh.h"\n'),
+        "a C API source including offline": ("libkeyanim/src/c_api/sample.cpp", '#include "keyanim/offline/fk.h"\n'),
+        "the C API header including offline": ("libkeyanim/include/keyanim.h", '#include "keyanim/offline/bvh.h"\n'),
         "the runtime target listing an offline source":
             ("libkeyanim/CMakeLists.txt", "add_library(keyanim_runtime src/runtime/load.cpp src/offline/encode.cpp)\n"),
         "a folder the README's layout does not name": ("docs/a.md", ""),

@@ -33,6 +33,11 @@ installs)  # root, one package missing: update, then install of exactly that pac
   grep -q '^apt-get .* install .*help2man' "$T/calls.log" || die "help2man not installed"
   grep '^apt-get .* install' "$T/calls.log" | grep -q cmake && die "installed a package that was there"
   ;;
+csharp)  # the C# example's compiler and runtime (tests/capi) are among the test packages
+  printf 'mono-mcs\nmono-runtime\n' >"$T/absent"
+  [ "$(run)" = 0 ] || die "exit code"
+  grep -q '^apt-get .* install .*mono-mcs mono-runtime' "$T/calls.log" || die "mono-mcs and mono-runtime not installed"
+  ;;
 sudo)  # not root, sudo available: apt-get through sudo
   echo help2man >"$T/absent"
   stub id 'echo 1000'

@@ -16,13 +16,17 @@ inline constexpr float kRadPerDeg = 0.017453292519943295f;
 // Scalar: s = sin(deg / 2), c = cos(deg / 2).
 inline void half_sincos_deg(float deg, float& s, float& c) noexcept {
   const float h = deg * 0.5f;
-  const float k = std::nearbyint(h * (1.0f / 90.0f));  // quadrant, round to nearest even
+  const float r = std::nearbyint(h * (1.0f / 90.0f));  // quadrant, round to nearest even
+  // As the SSE2 twin's cvtps2dq: outside int32's range (|angle| > 3.9e11 degrees) or NaN, the
+  // quadrant is INT32_MIN, and k is that, so that both paths give the same (meaningless) bits
+  // without an out-of-range conversion (undefined behaviour; fuzz_c_api found it).
+  const int32_t q = r >= -2147483648.0f && r < 2147483648.0f ? static_cast<int32_t>(r) : INT32_MIN;
+  const float k = static_cast<float>(q);                // = r inside the range
   const float x = (h - k * 90.0f) * kRadPerDeg;         // h - 90k is exact (Sterbenz)
   const float z = x * x;
   const float sp = ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f) * z * x + x;
   const float cp = ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z -
                    0.5f * z + 1.0f;
-  const int32_t q = static_cast<int32_t>(k);
   const float a = (q & 1) ? cp : sp;  // sin of the reduced angle's quadrant
   const float b = (q & 1) ? sp : cp;
   s = (q & 2) ? -a : a;
