@@ -153,10 +153,16 @@ def check(keyanim, clip_path, bvh_path, printed):
     got = [(s["by"], s["x"]) for s in printed["samples"]]
     if got != want:
         return problems + [f"positions sampled: {got}, expected {want}"]
+    last = meta["frames"] - 1
     for s in printed["samples"]:
         where = f"{s['by']} {s['x']!r}"
-        euler = cli_sample(keyanim, clip_path, s["by"], s["x"], world=False)
-        world = cli_sample(keyanim, clip_path, s["by"], s["x"], world=True)
+        # The C API clamps a frame beyond the clip to its ends, as Clip::sample does; `keyanim
+        # sample` refuses those (exit 1), so it is asked at the end the API clamps to.
+        by, x = s["by"], s["x"]
+        if by == "frame":
+            x = min(max(x, 0.0), float(last))
+        euler = cli_sample(keyanim, clip_path, by, x, world=False)
+        world = cli_sample(keyanim, clip_path, by, x, world=True)
         joints = [i for i, b in enumerate(bvh) if not b["end_site"]]
         if len(euler) != len(joints) or len(world) != len(bvh) or len(s["local"]) != len(bvh) or \
                 len(s["model"]) != len(bvh) or len(s["channels"] or []) != column:
