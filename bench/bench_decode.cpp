@@ -44,89 +44,32 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/acl_compare.h"
-#include "runtime/clip_access.h"
+#include "clock.h"
+#include "cold.h"  // the one reach past the public headers: flushing a clip for cold samples
 
 namespace {
+
+using bench::cpu_ns;
+using bench::fence;
+using bench::flush;
+using bench::flush_image;
+using bench::flush_vec;
+using bench::median;
+using bench::wall_ns;
 
 namespace fs = std::filesystem;
 using keyanim::Clip;
 using keyanim::offline::Motion;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
-// Thread CPU time for batches (the machines are shared; wall time would count waiting).
-double cpu_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e9 + double(t.tv_nsec);
-}
 template <class F>
 double batch_ns(F&& f) {
   const double t0 = cpu_ns();
   f();
   return cpu_ns() - t0;
 }
-double wall_ns() {
-  return double(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                    std::chrono::steady_clock::now().time_since_epoch()).count());
-}
-
 volatile float g_sink = 0;
 
-void flush(const void* p, size_t n) {
-#if defined(__x86_64__)
-  const auto* c = static_cast<const char*>(p);
-  for (size_t i = 0; i < n; i += 64) _mm_clflush(c + i);
-  if (n) _mm_clflush(c + n - 1);
-#else
-  (void)p, (void)n;
-#endif
-}
-void fence() {
-#if defined(__x86_64__)
-  _mm_mfence();
-#endif
-}
 
-// Every array of a clip's image, for the cold measurement.
-template <class V>
-void flush_vec(const V& v) {
-  flush(v.data(), v.size() * sizeof(v[0]));
-}
-void flush_image(const Clip& clip) {
-  const keyanim::internal::Image& img = keyanim::ClipAccess::image(clip);
-  flush(&img, sizeof img);
-  flush_vec(img.payload);
-  flush_vec(img.record_offset);
-  flush_vec(img.curves);
-  flush_vec(img.curve_of);
-  flush_vec(img.fixed_value);
-  flush_vec(img.fixed_channels);
-  flush_vec(img.node_offset);
-  flush_vec(img.curve_s);
-  flush_vec(img.first_frame);
-  flush_vec(img.last_frame);
-  flush_vec(img.first_value);
-  flush_vec(img.last_value);
-  flush_vec(img.curve_linear);
-  flush_vec(img.curve_channel);
-  flush_vec(img.list_frames);
-  flush_vec(img.list_values);
-  flush_vec(img.interp);
-  flush_vec(img.tension);
-  flush_vec(img.key_count);
-  flush_vec(img.fixed_frame);
-  flush_vec(img.rot_column);
-  flush_vec(img.rot_axis);
-  flush_vec(img.rot_first);
-  flush_vec(img.moves);
-  flush_vec(img.move_first);
-  flush_vec(img.skeleton.joints);
-  for (const auto& j : img.skeleton.joints) flush_vec(j.channels);
-}
 
 nlohmann::json measure(const Motion& m, bool speed) {
   keyanim::offline::EncodeSettings settings;

@@ -48,11 +48,20 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
+#include "clock.h"
 // Internal, for one purpose: the cold figure flushes every array a loaded clip owns, which only
 // the runtime's image layout lists (bench_decode does the same). Nothing else reads it.
-#include "runtime/clip_access.h"
+#include "cold.h"
 
 namespace {
+
+using bench::cpu_ns;
+using bench::fence;
+using bench::flush;
+using bench::flush_image;
+using bench::flush_vec;
+using bench::median;
+using bench::wall_ns;
 
 namespace fs = std::filesystem;
 namespace ko = keyanim::offline;
@@ -70,62 +79,8 @@ constexpr double kShell = 0.02;           // x size: keyanim's default shell (2%
 constexpr size_t kPoses = 2000;           // poses per timed batch
 constexpr size_t kColdPoses = 200;        // cold samples per round (each timed alone)
 
-// ---------------------------------------------------------------------------------------------
-// Clocks, caches, statistics
-
-double cpu_ns() {  // this thread's CPU time: the machine is shared, wall time would count waiting
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e9 + double(t.tv_nsec);
-}
-double wall_ns() {
-  return double(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                    std::chrono::steady_clock::now().time_since_epoch()).count());
-}
-
 volatile float g_sink = 0;  // keeps the samples from being optimized away
 void sink(float v) { g_sink = g_sink + v; }
-
-void flush(const void* p, size_t n) {
-#if defined(__x86_64__)
-  const auto* c = static_cast<const char*>(p);
-  for (size_t i = 0; i < n; i += 64) _mm_clflush(c + i);
-  if (n) _mm_clflush(c + n - 1);
-#else
-  (void)p, (void)n;
-#endif
-}
-void fence() {
-#if defined(__x86_64__)
-  _mm_mfence();
-#endif
-}
-template <class V>
-void flush_vec(const V& v) {
-  flush(v.data(), v.size() * sizeof(v[0]));
-}
-// Every array of a loaded clip's image (the list bench_decode keeps), plus the notes and names.
-void flush_image(const Clip& clip) {
-  const keyanim::internal::Image& img = keyanim::ClipAccess::image(clip);
-  flush(&img, sizeof img);
-  flush_vec(img.payload), flush_vec(img.record_offset), flush_vec(img.curves);
-  flush_vec(img.curve_of), flush_vec(img.fixed_value), flush_vec(img.fixed_channels);
-  flush_vec(img.node_offset), flush_vec(img.curve_s), flush_vec(img.first_frame);
-  flush_vec(img.last_frame), flush_vec(img.first_value), flush_vec(img.last_value);
-  flush_vec(img.curve_linear), flush_vec(img.curve_channel), flush_vec(img.list_frames);
-  flush_vec(img.list_values), flush_vec(img.interp), flush_vec(img.tension);
-  flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.rot_column);
-  flush_vec(img.rot_axis), flush_vec(img.rot_first), flush_vec(img.moves);
-  flush_vec(img.move_first), flush_vec(img.notes), flush_vec(img.skeleton.joints);
-  for (const auto& j : img.skeleton.joints) flush_vec(j.channels), flush_vec(j.name);
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // ---------------------------------------------------------------------------------------------
 // The clips
