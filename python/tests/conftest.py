@@ -27,6 +27,20 @@ CORPUS = Path(os.environ.get("KEYANIM_CORPUS_DIR", REPO.parent / "shared" / "cor
 CORPUS_SKIP = "keyanim-corpus-skip: %s not found" % CORPUS
 
 
+def frames_at_rate(n, frame_time, fps):
+    """decode.h's rule, written again from its comment: a rate within 0.01% of N times the
+    clip's own gives its frames and N-1 in-betweens, within 0.01% of it divided by M every M-th
+    frame, any other frames every 1/fps s up to the end."""
+    if n <= 1:
+        return n
+    r = fps * frame_time
+    if round(r) >= 1 and abs(r - round(r)) <= 1e-4 * r:
+        return (n - 1) * round(r) + 1
+    if round(1 / r) >= 2 and abs(1 / r - round(1 / r)) <= 1e-4 / r:
+        return (n - 1) // round(1 / r) + 1
+    return int(np.floor((n - 1) * frame_time * fps + 1e-6)) + 1
+
+
 def corpus_files():
     """Every .bvh of the shared corpus, sorted; empty without it."""
     return sorted(CORPUS.rglob("*.bvh")) if CORPUS.is_dir() else []

@@ -9,8 +9,8 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import (HOP, WALK, cli, cli_json, corpus_files, local_rotations, local_translations, parse_bvh,
-                      quaternion_matrices, world_positions)
+from conftest import (HOP, WALK, cli, cli_json, corpus_files, frames_at_rate, local_rotations, local_translations,
+                      parse_bvh, quaternion_matrices, world_positions)
 
 F = np.float32
 
@@ -192,6 +192,8 @@ def test_a_rate_within_rounding_of_the_clips_own(keyanim, walk_clip):
     assert np.array_equal(walk_clip.frame_positions_at(40, [0, 1, 114]), [0.0, 3.0, 342.0])
     assert walk_clip.frame_count_at(40) == 115
     assert walk_clip.frame_count_at(119) == int(np.floor(343 * 0.0083333 * 119 + 1e-6)) + 1
+    for fps in (15, 24, 30, 40, 60, 100, 119, 120, 240, 360):
+        assert walk_clip.frame_count_at(fps) == frames_at_rate(344, 0.0083333, fps) == walk_clip.to_motion(fps=fps).frame_count
     assert walk_clip.frame_positions_at(119, [7])[0] == (7 / 119) / 0.0083333
     assert walk_clip.frame_count_at() == 344
     assert np.array_equal(walk_clip.frame_positions_at(None, [-3, 5, 999]), [0.0, 5.0, 343.0])
@@ -304,7 +306,7 @@ def test_corpus_clips(keyanim, path, tmp_path):
         times = positions * clip.frame_time
         np.testing.assert_allclose(clip.sample(times), rows, rtol=1e-5, atol=1e-5)
         m30 = clip.to_motion(fps=30)
-        assert m30.frame_count == int(np.floor((n - 1) * clip.frame_time * 30 + 1e-6)) + 1
+        assert m30.frame_count == frames_at_rate(n, clip.frame_time, 30)
     assert np.array_equal(clip.to_motion().channels, clip.sample_frames(np.arange(float(n))).astype(np.float64))
     path = tmp_path / "clip.kanim"
     path.write_bytes(data)

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import HOP, WALK, corpus_files
+from conftest import HOP, WALK, corpus_files, frames_at_rate
 
 
 @pytest.fixture(scope="module")
@@ -140,10 +140,7 @@ def test_corpus_dataset(keyanim, tmp_path):
         ds = keyanim.Dataset(corpus_files(), fps=30, window=32, output=("channels", "world_positions"))
     total = 0
     for clip in ds.clips:
-        frames = clip.frame_count
-        if frames > 1:
-            frames = math.floor((frames - 1) * clip.frame_time * 30 + 1e-6) + 1
-        total += expected_windows(frames, 32, 32)
+        total += expected_windows(frames_at_rate(clip.frame_count, clip.frame_time, 30), 32, 32)
     assert len(ds) == total > 0
     rng = np.random.default_rng(1)
     for i in rng.integers(0, len(ds), 50):
