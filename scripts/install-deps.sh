@@ -18,6 +18,8 @@ REQUIRED=(
   doctest-dev python3                                                 # the test suite
   help2man man-db                                                     # the man page, and its test
   git                                                                 # the newcomer test's clone
+  ccache           # scripts/configure.sh: the test builds reuse what the set-up compiled
+  bash-completion  # tab completion of the installed tool (tools/completion/keyanim)
   parallel procps  # tests/cli/manifest_test.sh runs the README's GNU parallel recipe (and kills it)
   # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
   # matplotlib for examples/plot_channel.py.
