@@ -43,9 +43,9 @@ inline void flush_image(const keyanim::Clip& clip) {
   flush_vec(img.last_frame), flush_vec(img.first_value), flush_vec(img.last_value);
   flush_vec(img.curve_linear), flush_vec(img.curve_channel), flush_vec(img.list_frames);
   flush_vec(img.list_values), flush_vec(img.interp), flush_vec(img.tension);
-  flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.rot_column);
-  flush_vec(img.rot_axis), flush_vec(img.rot_first), flush_vec(img.moves);
-  flush_vec(img.move_first), flush_vec(img.notes), flush_vec(img.skeleton.joints);
+  flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.rot_groups);
+  flush_vec(img.group_node), flush_vec(img.group_column), flush_vec(img.moves);
+  flush_vec(img.notes), flush_vec(img.skeleton.joints);
   for (const auto& j : img.skeleton.joints) flush_vec(j.channels), flush_vec(j.name);
 }
 

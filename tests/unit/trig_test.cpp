@@ -24,7 +24,11 @@ TEST_CASE("half_sincos_deg: scalar and four-wide paths agree bit for bit, huge a
   for (float a = 1.0f; a < 1e38f; a *= 7.3f) angles.insert(angles.end(), {a, -a});
   while (angles.size() % 4 != 0) angles.push_back(1.0f);
   std::vector<float> s4(angles.size()), c4(angles.size());
-  keyanim::internal::half_sincos_deg(angles.data(), s4.data(), c4.data(), uint32_t(angles.size()));
+  for (size_t i = 0; i < angles.size(); i += 4) {
+    keyanim::internal::F4 s, c;
+    keyanim::internal::half_sincos_deg(keyanim::internal::F4::load(&angles[i]), s, c);
+    s.store(&s4[i]), c.store(&c4[i]);
+  }
   for (size_t i = 0; i < angles.size(); ++i) {
     float s1, c1;
     keyanim::internal::half_sincos_deg(angles[i], s1, c1);

@@ -1,5 +1,5 @@
 // Sine and cosine of half an angle given in degrees, for Euler-to-quaternion conversion: four
-// angles at a time with SSE2, and a scalar twin that performs the same binary32 operations
+// angles at a time (F4: SSE2), and a scalar twin that performs the same binary32 operations
 // (so both give identical results). Accurate to about 1 ulp for the angles motion capture
 // holds (|angle| < 10^6 degrees): the angle is reduced by multiples of 90 degrees exactly
 // before it is converted to radians, and the polynomials are Cephes' sinf/cosf on [-pi/4, pi/4].
@@ -33,37 +33,35 @@ inline void half_sincos_deg(float deg, float& s, float& c) noexcept {
   c = ((q + 1) & 2) ? -b : b;
 }
 
-// n angles (any n): s[i] = sin(deg[i] / 2), c[i] = cos(deg[i] / 2).
-inline void half_sincos_deg(const float* deg, float* s, float* c, uint32_t n) noexcept {
-  uint32_t i = 0;
 #if KEYANIM_SSE2
-  const __m128 half = _mm_set1_ps(0.5f), inv90 = _mm_set1_ps(1.0f / 90.0f), n90 = _mm_set1_ps(90.0f);
-  const __m128 rad = _mm_set1_ps(kRadPerDeg);
+// Four angles at once: the scalar twin's operations lane by lane.
+inline void half_sincos_deg(F4 deg, F4& s, F4& c) noexcept {
+  const __m128 half = _mm_set1_ps(0.5f);
   const __m128i one = _mm_set1_epi32(1), two = _mm_set1_epi32(2);
   const __m128 sign = _mm_set1_ps(-0.0f);
-  for (; i + 4 <= n; i += 4) {
-    const __m128 h = _mm_mul_ps(_mm_loadu_ps(deg + i), half);
-    const __m128i q = _mm_cvtps_epi32(_mm_mul_ps(h, inv90));  // round to nearest even (MXCSR default)
-    const __m128 k = _mm_cvtepi32_ps(q);
-    const __m128 x = _mm_mul_ps(_mm_sub_ps(h, _mm_mul_ps(k, n90)), rad);
-    const __m128 z = _mm_mul_ps(x, x);
-    __m128 sp = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(-1.9515295891e-4f), z), _mm_set1_ps(8.3321608736e-3f));
-    sp = _mm_sub_ps(_mm_mul_ps(sp, z), _mm_set1_ps(1.6666654611e-1f));
-    sp = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(sp, z), x), x);
-    __m128 cp = _mm_sub_ps(_mm_mul_ps(_mm_set1_ps(2.443315711809948e-5f), z), _mm_set1_ps(1.388731625493765e-3f));
-    cp = _mm_add_ps(_mm_mul_ps(cp, z), _mm_set1_ps(4.166664568298827e-2f));
-    cp = _mm_add_ps(_mm_sub_ps(_mm_mul_ps(_mm_mul_ps(cp, z), z), _mm_mul_ps(half, z)), _mm_set1_ps(1.0f));
-    const __m128 swap = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(q, one), one));
-    const __m128 a = _mm_or_ps(_mm_and_ps(swap, cp), _mm_andnot_ps(swap, sp));
-    const __m128 b = _mm_or_ps(_mm_and_ps(swap, sp), _mm_andnot_ps(swap, cp));
-    const __m128 sa = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(q, two), two)), sign);
-    const __m128 sb =
-        _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_add_epi32(q, one), two), two)), sign);
-    _mm_storeu_ps(s + i, _mm_xor_ps(a, sa));
-    _mm_storeu_ps(c + i, _mm_xor_ps(b, sb));
-  }
-#endif
-  for (; i < n; ++i) half_sincos_deg(deg[i], s[i], c[i]);
+  const __m128 h = _mm_mul_ps(deg.v, half);
+  const __m128i q = _mm_cvtps_epi32(_mm_mul_ps(h, _mm_set1_ps(1.0f / 90.0f)));  // round to nearest even (MXCSR default)
+  const __m128 k = _mm_cvtepi32_ps(q);
+  const __m128 x = _mm_mul_ps(_mm_sub_ps(h, _mm_mul_ps(k, _mm_set1_ps(90.0f))), _mm_set1_ps(kRadPerDeg));
+  const __m128 z = _mm_mul_ps(x, x);
+  __m128 sp = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(-1.9515295891e-4f), z), _mm_set1_ps(8.3321608736e-3f));
+  sp = _mm_sub_ps(_mm_mul_ps(sp, z), _mm_set1_ps(1.6666654611e-1f));
+  sp = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(sp, z), x), x);
+  __m128 cp = _mm_sub_ps(_mm_mul_ps(_mm_set1_ps(2.443315711809948e-5f), z), _mm_set1_ps(1.388731625493765e-3f));
+  cp = _mm_add_ps(_mm_mul_ps(cp, z), _mm_set1_ps(4.166664568298827e-2f));
+  cp = _mm_add_ps(_mm_sub_ps(_mm_mul_ps(_mm_mul_ps(cp, z), z), _mm_mul_ps(half, z)), _mm_set1_ps(1.0f));
+  const __m128 swap = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(q, one), one));
+  const __m128 a = _mm_or_ps(_mm_and_ps(swap, cp), _mm_andnot_ps(swap, sp));
+  const __m128 b = _mm_or_ps(_mm_and_ps(swap, sp), _mm_andnot_ps(swap, cp));
+  const __m128 sa = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(q, two), two)), sign);
+  const __m128 sb = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_add_epi32(q, one), two), two)), sign);
+  s = F4(_mm_xor_ps(a, sa));
+  c = F4(_mm_xor_ps(b, sb));
 }
+#else
+inline void half_sincos_deg(F4 deg, F4& s, F4& c) noexcept {
+  for (int i = 0; i < 4; ++i) half_sincos_deg(deg.v[i], s.v[i], c.v[i]);
+}
+#endif
 
 }  // namespace keyanim::internal

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "internal/clip_source.h"
+#include "internal/format.h"
 #include "keyanim/cardinal.h"
 #include "keyanim/skeleton.h"
 
@@ -57,20 +58,25 @@ struct Image {
   double frame_time = 0.0;
   TangentRule rule = TangentRule::step_adjusted;
   Skeleton skeleton;
-  std::vector<float> node_offset;  // 3 per node: OFFSET in binary32, for poses
-  // Poses: each node's rotation channels (column and axis, in channel order: the order they
-  // compose in) and its position channels, nodes one after the other. Node i's rotations are
-  // rot_column/rot_axis[rot_first[i] .. rot_first[i + 1]), its positions
-  // moves[move_first[i] .. move_first[i + 1]). Rotation columns are contiguous so that a
-  // batch of angles is one gather.
+  // Poses (pose.cpp). node_offset: 4 per node, its OFFSET in binary32 and a 0 (Transform's
+  // translation and reserved, one copy). Rotations: nodes are grouped by the axes of their
+  // rotation channels in order (Z X Y for most BVH joints, none for End Sites), so that 4 nodes
+  // of a group become quaternions in one register per component, one step per channel.
+  // Positions: every position channel, in node order.
+  struct RotationGroup {
+    uint32_t node_first, node_count;  // its nodes: group_node[node_first ..), in increasing order
+    uint32_t column_first;            // step k's columns: group_column[column_first + k * node_count ..)
+    uint32_t steps;                   // rotation channels per node (<= kMaxNodeChannels)
+    uint8_t axis[kMaxNodeChannels];   // their axes in composition order: 0 X, 1 Y, 2 Z
+  };
   struct Move {
-    uint32_t column;
+    uint32_t node, column;
     uint32_t axis;  // 0 X, 1 Y, 2 Z
   };
-  std::vector<uint32_t> rot_column, rot_first;
-  std::vector<uint8_t> rot_axis;  // 0 X, 1 Y, 2 Z
+  std::vector<float> node_offset;
+  std::vector<RotationGroup> rot_groups;
+  std::vector<uint32_t> group_node, group_column;
   std::vector<Move> moves;
-  std::vector<uint32_t> move_first;
   std::string notes;
   uint64_t total_keys = 0;
   uint64_t id = 0;  // distinguishes clips for cursors (an address can be reused)

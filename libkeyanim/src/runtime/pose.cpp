@@ -5,59 +5,86 @@
 #include "runtime/pose.h"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstring>
 
 #include "internal/trig.h"
 
 namespace keyanim::internal {
 namespace {
 
+// Four nodes' rotations, one component per register: lane i is node i's quaternion.
+struct Quat4 {
+  F4 x, y, z, w;
+};
+
 // q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w):
 // each component is one product with c plus one signed product with s,
 //   X: (x c + w s, y c + z s, z c - y s, w c - x s)
 //   Y: (x c - z s, y c + w s, z c + x s, w c - y s)
 //   Z: (x c + y s, y c - x s, z c + w s, w c - z s).
-#if KEYANIM_SSE2
-// In one register: q c + t s, t a signed permutation of q per axis. The products and sums are
-// those above (a + (-b) is a - b, and addition commutes), so the bits are the scalar twin's
-// (tests/scalar checks it).
-[[gnu::always_inline]] inline __m128 rotate_by(__m128 q, uint32_t axis, float s, float c) noexcept {
-  const __m128 neg23 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, INT32_MIN, 0, 0));
-  const __m128 neg03 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, 0, INT32_MIN));
-  const __m128 neg13 = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, INT32_MIN, 0));
-  __m128 t;
+// The axis is the same in every lane (a group's), so the choice is made once for four nodes.
+inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
   switch (axis) {
-    case 0: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(0, 1, 2, 3)), neg23); break;   // (w, z, -y, -x)
-    case 1: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(1, 0, 3, 2)), neg03); break;   // (-z, w, x, -y)
-    default: t = _mm_xor_ps(_mm_shuffle_ps(q, q, _MM_SHUFFLE(2, 3, 0, 1)), neg13); break;  // (y, -x, w, -z)
-  }
-  return _mm_add_ps(_mm_mul_ps(q, _mm_set1_ps(c)), _mm_mul_ps(t, _mm_set1_ps(s)));
-}
-#else
-inline void rotate_by(float* q, uint32_t axis, float s, float c) noexcept {
-  const float x = q[0], y = q[1], z = q[2], w = q[3];
-  switch (axis) {
-    case 0: q[0] = x * c + w * s, q[1] = y * c + z * s, q[2] = z * c - y * s, q[3] = w * c - x * s; break;
-    case 1: q[0] = x * c - z * s, q[1] = y * c + w * s, q[2] = z * c + x * s, q[3] = w * c - y * s; break;
-    default: q[0] = x * c + y * s, q[1] = y * c - x * s, q[2] = z * c + w * s, q[3] = w * c - z * s; break;
+    case 0: return {q.x * c + q.w * s, q.y * c + q.z * s, q.z * c - q.y * s, q.w * c - q.x * s};
+    case 1: return {q.x * c - q.z * s, q.y * c + q.w * s, q.z * c + q.x * s, q.w * c - q.y * s};
+    default: return {q.x * c + q.y * s, q.y * c - q.x * s, q.z * c + q.w * s, q.w * c - q.z * s};
   }
 }
-#endif
 
-// Node `node`'s rotation, its angles' half sines and cosines at s[k - base], c[k - base].
-inline void node_rotation(const Image& img, uint32_t node, uint32_t base, const float* s, const float* c,
-                          float* rotation) noexcept {
-  const uint8_t* axis = img.rot_axis.data();
-  const uint32_t begin = img.rot_first[node], end = img.rot_first[node + 1];
-#if KEYANIM_SSE2
-  __m128 q = _mm_set_ps(1.0f, 0.0f, 0.0f, 0.0f);
-  for (uint32_t k = begin; k < end; ++k) q = rotate_by(q, axis[k], s[k - base], c[k - base]);
-  _mm_storeu_ps(rotation, q);
-#else
-  rotation[0] = rotation[1] = rotation[2] = 0.0f, rotation[3] = 1.0f;
-  for (uint32_t k = begin; k < end; ++k) rotate_by(rotation, axis[k], s[k - base], c[k - base]);
-#endif
+// The rotations of a group's nodes [begin, end) (indices into the group), out[node - first].
+void group_rotations(const Image& img, const Image::RotationGroup& g, uint32_t begin, uint32_t end,
+                     const float* values, uint32_t column0, uint32_t first, Transform* out) noexcept {
+  const uint32_t* node = img.group_node.data() + g.node_first;
+  for (uint32_t i = begin; i < end; i += 4) {
+    const uint32_t lanes = std::min(4u, end - i);
+    Quat4 q{F4(0.0f), F4(0.0f), F4(0.0f), F4(1.0f)};
+    for (uint32_t k = 0; k < g.steps; ++k) {
+      const uint32_t* column = img.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
+      alignas(16) float angle[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      for (uint32_t l = 0; l < lanes; ++l) angle[l] = values[column[l] - column0];
+      F4 s, c;
+      half_sincos_deg(F4::load(angle), s, c);
+      q = rotate_by(q, g.axis[k], s, c);
+    }
+    transpose(q.x, q.y, q.z, q.w);  // now lane rows: node i's (x, y, z, w) in q.x, i + 1's in q.y, ...
+    const F4* row[4] = {&q.x, &q.y, &q.z, &q.w};
+    for (uint32_t l = 0; l < lanes; ++l) row[l]->store(out[node[i + l] - first].rotation);
+  }
 }
 
+// The first index of `sorted` (ascending, n entries) whose value is >= x.
+inline uint32_t lower_index(const uint32_t* sorted, uint32_t n, uint32_t x) noexcept {
+  return static_cast<uint32_t>(std::lower_bound(sorted, sorted + n, x) - sorted);
+}
+
+#if KEYANIM_SSE2
+// The products and sums of the scalar twins below, in their order, lanes x, y, z (w): a - b is
+// a + (-b) and (-a) b is -(a b) exactly, so the bits are the scalar twins' (tests/scalar).
+template <int a, int b, int c, int d>
+[[gnu::always_inline]] inline __m128 shuffle(__m128 v) noexcept {
+  return _mm_shuffle_ps(v, v, _MM_SHUFFLE(d, c, b, a));
+}
+[[gnu::always_inline]] inline __m128 flip(__m128 v, bool x, bool y, bool z, bool w) noexcept {
+  return _mm_xor_ps(v, _mm_castsi128_ps(_mm_set_epi32(w ? INT32_MIN : 0, z ? INT32_MIN : 0, y ? INT32_MIN : 0,
+                                                      x ? INT32_MIN : 0)));
+}
+[[gnu::always_inline]] inline __m128 multiply(__m128 a, __m128 b) noexcept {
+  const __m128 t1 = _mm_mul_ps(shuffle<3, 3, 3, 3>(a), b);
+  const __m128 t2 = _mm_mul_ps(shuffle<0, 0, 0, 0>(a), flip(shuffle<3, 2, 1, 0>(b), false, true, false, true));
+  const __m128 t3 = _mm_mul_ps(shuffle<1, 1, 1, 1>(a), flip(shuffle<2, 3, 0, 1>(b), false, false, true, true));
+  const __m128 t4 = _mm_mul_ps(shuffle<2, 2, 2, 2>(a), flip(shuffle<1, 0, 3, 2>(b), true, false, false, true));
+  return _mm_add_ps(_mm_add_ps(_mm_add_ps(t1, t2), t3), t4);
+}
+[[gnu::always_inline]] inline __m128 rotate_vector(__m128 q, __m128 v) noexcept {
+  const __m128 cross = _mm_sub_ps(_mm_mul_ps(shuffle<1, 2, 0, 3>(q), shuffle<2, 0, 1, 3>(v)),
+                                  _mm_mul_ps(shuffle<2, 0, 1, 3>(q), shuffle<1, 2, 0, 3>(v)));
+  const __m128 t = _mm_mul_ps(_mm_set1_ps(2.0f), cross);
+  const __m128 turn = _mm_sub_ps(_mm_mul_ps(shuffle<1, 2, 0, 3>(q), shuffle<2, 0, 1, 3>(t)),
+                                 _mm_mul_ps(shuffle<2, 0, 1, 3>(q), shuffle<1, 2, 0, 3>(t)));
+  return _mm_add_ps(_mm_add_ps(v, _mm_mul_ps(shuffle<3, 3, 3, 3>(q), t)), turn);
+}
+#else
 // v rotated by unit quaternion q: v + 2 w (u x v) + 2 u x (u x v), u = q.xyz.
 inline void rotate_vector(const float* q, const float* v, float* out) noexcept {
   const float tx = 2.0f * (q[1] * v[2] - q[2] * v[1]);
@@ -76,8 +103,10 @@ inline void multiply(const float* a, const float* b, float* out) noexcept {
   const float w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
   out[0] = x, out[1] = y, out[2] = z, out[3] = w;
 }
+#endif
 
-constexpr uint32_t kAngles = 64;  // rotation channels converted per batch (>= 6, a node's most)
+static_assert(offsetof(Transform, reserved) == offsetof(Transform, translation) + 3 * sizeof(float),
+              "a node's translation and reserved are one 4-float copy of Image::node_offset");
 
 }  // namespace
 
@@ -85,29 +114,22 @@ void local_transforms(const Image& img, uint32_t first, uint32_t last, const flo
                       Transform* out) noexcept {
   if (first >= last) return;
   const uint32_t column0 = img.skeleton.joints[first].first_channel;  // values[0]'s column
-  const uint32_t* rot_first = img.rot_first.data();
-  const uint32_t* rot_column = img.rot_column.data();
-  alignas(16) float angles[kAngles], sines[kAngles], cosines[kAngles];
-  for (uint32_t node = first; node < last;) {
-    // Nodes [node, end) whose rotation channels fit one batch: one gather, one conversion.
-    const uint32_t base = rot_first[node];
-    uint32_t end = node + 1;
-    while (end < last && rot_first[end + 1] - base <= kAngles) ++end;
-    const uint32_t count = rot_first[end] - base;
-    for (uint32_t k = 0; k < count; ++k) angles[k] = values[rot_column[base + k] - column0];
-    half_sincos_deg(angles, sines, cosines, count);
-    for (; node < end; ++node) {
-      Transform& t = out[node - first];
-      const float* offset = img.node_offset.data() + 3 * size_t(node);
-      t.translation[0] = offset[0], t.translation[1] = offset[1], t.translation[2] = offset[2];
-      t.reserved = 0.0f;
-      for (uint32_t m = img.move_first[node]; m < img.move_first[node + 1]; ++m) {
-        const Image::Move move = img.moves[m];
-        const float v = values[move.column - column0];
-        t.translation[move.axis] = reading == PositionReading::add ? offset[move.axis] + v : v;
-      }
-      node_rotation(img, node, base, sines, cosines, t.rotation);
-    }
+  // Translations: OFFSETs (and reserved = 0), then the position channels.
+  for (uint32_t node = first; node < last; ++node)
+    std::memcpy(out[node - first].translation, img.node_offset.data() + 4 * size_t(node), 4 * sizeof(float));
+  const Image::Move* moves = img.moves.data();
+  const auto by_node = [](const Image::Move& m, uint32_t node) { return m.node < node; };
+  const Image::Move* m = std::lower_bound(moves, moves + img.moves.size(), first, by_node);
+  for (; m != moves + img.moves.size() && m->node < last; ++m) {
+    const float v = values[m->column - column0];
+    float& t = out[m->node - first].translation[m->axis];
+    t = reading == PositionReading::add ? img.node_offset[4 * size_t(m->node) + m->axis] + v : v;
+  }
+  // Rotations, group by group: the group's nodes in [first, last).
+  for (const Image::RotationGroup& g : img.rot_groups) {
+    const uint32_t* node = img.group_node.data() + g.node_first;
+    const uint32_t begin = lower_index(node, g.node_count, first), end = lower_index(node, g.node_count, last);
+    group_rotations(img, g, begin, end, values, column0, first, out);
   }
 }
 
@@ -118,11 +140,19 @@ void compose_model(const Image& img, Transform* out) noexcept {
     if (p < 0) continue;  // parents come first: out[p] is already in model space
     const Transform& parent = out[p];
     Transform& t = out[i];
+#if KEYANIM_SSE2
+    const __m128 pq = _mm_loadu_ps(parent.rotation);
+    const __m128 moved = rotate_vector(pq, _mm_loadu_ps(t.translation));  // lane 3: reserved's, dropped
+    const __m128 keep3 = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+    _mm_storeu_ps(t.translation, _mm_and_ps(_mm_add_ps(_mm_loadu_ps(parent.translation), moved), keep3));
+    _mm_storeu_ps(t.rotation, multiply(pq, _mm_loadu_ps(t.rotation)));
+#else
     float moved[3], q[4];
     rotate_vector(parent.rotation, t.translation, moved);
     multiply(parent.rotation, t.rotation, q);
     for (int k = 0; k < 3; ++k) t.translation[k] = parent.translation[k] + moved[k];
     std::copy(q, q + 4, t.rotation);
+#endif
   }
 }
 
