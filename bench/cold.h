@@ -39,14 +39,15 @@ inline void flush_image(const keyanim::Clip& clip) {
   flush(&img, sizeof img);
   flush_vec(img.payload), flush_vec(img.record_offset), flush_vec(img.curves);
   flush_vec(img.curve_of), flush_vec(img.fixed_value), flush_vec(img.fixed_channels);
-  flush_vec(img.node_offset), flush_vec(img.curve_s), flush_vec(img.first_frame);
+  flush(img.rig.get(), sizeof *img.rig), flush_vec(img.rig->node_offset), flush_vec(img.curve_s);
+  flush_vec(img.first_frame);
   flush_vec(img.last_frame), flush_vec(img.first_value), flush_vec(img.last_value);
   flush_vec(img.curve_linear), flush_vec(img.curve_channel), flush_vec(img.list_frames);
   flush_vec(img.list_values), flush_vec(img.interp), flush_vec(img.tension);
-  flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.rot_groups);
-  flush_vec(img.group_node), flush_vec(img.group_column), flush_vec(img.moves);
-  flush_vec(img.notes), flush_vec(img.skeleton.joints);
-  for (const auto& j : img.skeleton.joints) flush_vec(j.channels), flush_vec(j.name);
+  flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.rig->rot_groups);
+  flush_vec(img.rig->group_node), flush_vec(img.rig->group_column), flush_vec(img.rig->moves);
+  flush_vec(img.notes), flush_vec(img.rig->skeleton.joints);
+  for (const auto& j : img.rig->skeleton.joints) flush_vec(j.channels), flush_vec(j.name);
 }
 
 }  // namespace bench

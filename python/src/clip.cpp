@@ -36,7 +36,7 @@ std::vector<uint8_t> buffer_bytes(const py::object& source) {
   return bytes;
 }
 
-std::shared_ptr<PyClip> load(const py::object& source) {
+std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
   auto c = std::make_shared<PyClip>();
   std::vector<uint8_t> bytes;
   const bool in_memory = py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source) ||
@@ -49,7 +49,7 @@ std::shared_ptr<PyClip> load(const py::object& source) {
   py::gil_scoped_release unlocked;
   if (c->file) bytes = offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
   ErrorInfo info;
-  if (Clip::load(bytes, c->clip, &info) != Status::ok) throw offline::Error::kanim(c->file.value_or(""), info);
+  if (Clip::load(bytes, c->clip, &info, {}, rigs) != Status::ok) throw offline::Error::kanim(c->file.value_or(""), info);
   c->bytes = bytes.size();
   return c;
 }
@@ -118,11 +118,17 @@ const char* const kClipDoc =
 void register_clip(py::module_& m) {
   py::class_<PyClip, std::shared_ptr<PyClip>> cls(m, "Clip", kClipDoc);
   cls.attr("__module__") = "keyanim";  // as users import it (signatures say keyanim.Clip)
-  cls.def(py::init(&load), py::arg("path_or_bytes"),
+  py::class_<RigCache>(m, "RigCache",
+                       "Clips of one rig (same nodes, names, parents, offsets, channel lists) loaded with\n"
+                       "the same RigCache (Clip(path, rigs=cache)) share one skeleton in memory.")
+      .def(py::init<>())
+      .def_property_readonly("rig_count", &RigCache::rig_count, "Rigs in use by at least one clip.");
+  cls.def(py::init(&load), py::arg("path_or_bytes"), py::arg("rigs") = nullptr,
           "Loads a .kanim from a path (str or os.PathLike) or from bytes (bytes, bytearray,\n"
           "memoryview; a view that is not C-contiguous, such as memoryview(b)[::2], is copied in\n"
           "order first, as bytes(view) would). A file is refused by its first bytes if it is not\n"
-          "a .kanim (/dev/zero), and past 1 GiB.");
+          "a .kanim (/dev/zero), and past 1 GiB. With rigs (a RigCache), clips of one rig share\n"
+          "their skeleton.");
   cls.def_static(
       "from_motion",
       [](const PyMotion& motion) {
@@ -150,6 +156,11 @@ void register_clip(py::module_& m) {
                             "for every clip of one skeleton.");
   cls.def_property_readonly("animation_bytes", [](const PyClip& c) { return c.clip.animation_bytes(); },
                             "Bytes of the clip's own motion (keys, records, per-channel facts, notes).");
+  cls.def_property_readonly("rig_hash", [](const PyClip& c) { return c.clip.rig_hash(); },
+                            "64-bit FNV-1a of the rig (each node's name, parent, offset bits, End Site flag and\n"
+                            "channel list): equal for clips of one skeleton.");
+  cls.def("shares_rig", [](const PyClip& a, const PyClip& b) { return a.clip.shares_rig(b.clip); }, py::arg("other"),
+          "Whether both clips hold the very same skeleton in memory (loaded with one RigCache).");
   cls.def_property_readonly("encoder_notes", [](const PyClip& c) { return text(c.clip.encoder_notes()); },
                             "The encoder's key=value notes stored in the file (settings, error reached).");
   cls.def_property_readonly(

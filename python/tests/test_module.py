@@ -10,7 +10,7 @@ from conftest import REPO
 
 
 def test_exports_and_versions():
-    assert set(keyanim.__all__) == {"Clip", "Dataset", "Error", "Motion", "encode", "format_version",
+    assert set(keyanim.__all__) == {"Clip", "Dataset", "Error", "Motion", "RigCache", "encode", "format_version",
                                     "measure_error", "read_bvh"}
     assert re.fullmatch(r"\d+\.\d+\.\d+", keyanim.__version__)
     assert re.fullmatch(r"\d+\.\d+", keyanim.format_version)

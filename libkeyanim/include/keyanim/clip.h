@@ -20,6 +20,7 @@ namespace keyanim {
 
 namespace internal {
 struct Image;
+struct RigCacheAccess;
 }
 
 // Upper bounds a loader checks before it allocates anything a file declares.
@@ -40,6 +41,27 @@ struct ChannelInfo {
 
 class Cursor;
 
+// Clips of one rig (the same nodes, names, parents, OFFSETs and channel lists, in the same
+// order: a character's clips) loaded through the same RigCache share one skeleton and the pose
+// tables made from it, so that an engine holding a thousand clips of one character holds its
+// skeleton once; each clip's skeleton_bytes() is then the shared rig's. Thread-safe: clips may
+// be loaded through one cache from several threads. The cache holds rigs weakly (a rig lives
+// as long as a clip uses it), and may be destroyed before or after the clips.
+class RigCache {
+ public:
+  RigCache();
+  ~RigCache();
+  RigCache(const RigCache&) = delete;
+  RigCache& operator=(const RigCache&) = delete;
+  // Rigs in use by at least one clip loaded through this cache.
+  size_t rig_count() const noexcept;
+
+ private:
+  friend struct internal::RigCacheAccess;
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 class Clip {
  public:
   Clip();  // empty: no frames, no channels
@@ -54,12 +76,13 @@ class Clip {
   // offset: the absolute offset of the offending field, or, inside a zstd-compressed section,
   // the offset of the section's stored bytes (`detail` then gives the offset within the
   // decompressed content). Reads every format version from 1.0 on.
+  // With `rigs`, the clip shares the cache's rig when it holds an equal one (RigCache).
   static Status load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err = nullptr,
-                     const DecodeLimits& limits = {});
+                     const DecodeLimits& limits = {}, RigCache* rigs = nullptr);
   // Reads the whole file, then load(). A file larger than limits.max_decompressed_bytes is
   // refused with limit_exceeded before it is read.
   static Status load_file(const std::string& path, Clip& out, ErrorInfo* err = nullptr,
-                          const DecodeLimits& limits = {});
+                          const DecodeLimits& limits = {}, RigCache* rigs = nullptr);
 
   uint16_t version_major() const noexcept;
   uint16_t version_minor() const noexcept;
@@ -84,9 +107,15 @@ class Clip {
   // lists and the pose tables made from them) is the same for every clip of one rig, which an
   // engine would hold once; the animation's part (keys, records, per-channel facts, notes) is
   // the clip's own.
+  // Clips loaded through one RigCache share that part (shares_rig).
   size_t memory_bytes() const noexcept;
   size_t skeleton_bytes() const noexcept;
   size_t animation_bytes() const noexcept;
+  // 64-bit FNV-1a of the rig (each node's name, parent, OFFSET bits, End Site flag and channel
+  // list, in node order): equal for clips of one rig, whichever file or cache they came from.
+  uint64_t rig_hash() const noexcept;
+  // Whether this clip and `other` hold the very same rig (loaded through one RigCache).
+  bool shares_rig(const Clip& other) const noexcept;
 
   // Every channel at frame position f (fractional frames are in-betweens; clamped to the clip),
   // exactly as spec/FORMAT.md Appendix A computes it, with f rounded to binary32. `out` must

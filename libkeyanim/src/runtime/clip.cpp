@@ -20,8 +20,19 @@ using internal::Image;
 
 namespace {
 
+// An empty clip's image, with an empty rig that nothing allocates (an aliasing pointer with no
+// owner): the accessors below never throw.
 const Image& empty_image() {
-  static const Image kEmpty;
+  static const internal::Rig kEmptyRig = [] {
+    internal::Rig r;
+    r.hash = internal::rig_hash(r.skeleton);
+    return r;
+  }();
+  static const Image kEmpty = [] {
+    Image i;
+    i.rig = std::shared_ptr<const internal::Rig>(std::shared_ptr<const internal::Rig>(), &kEmptyRig);
+    return i;
+  }();
   return kEmpty;
 }
 
@@ -50,12 +61,14 @@ uint32_t Clip::frame_count() const noexcept { return KEYANIM_IMG.frame_count; }
 double Clip::frame_time() const noexcept { return KEYANIM_IMG.frame_time; }
 uint32_t Clip::channel_count() const noexcept { return static_cast<uint32_t>(KEYANIM_IMG.interp.size()); }
 TangentRule Clip::tangent_rule() const noexcept { return KEYANIM_IMG.rule; }
-const Skeleton& Clip::skeleton() const noexcept { return KEYANIM_IMG.skeleton; }
+const Skeleton& Clip::skeleton() const noexcept { return KEYANIM_IMG.rig->skeleton; }
 uint64_t Clip::total_keys() const noexcept { return KEYANIM_IMG.total_keys; }
 const std::string& Clip::encoder_notes() const noexcept { return KEYANIM_IMG.notes; }
 size_t Clip::memory_bytes() const noexcept { return image_ ? image_->memory_bytes() : 0; }
 size_t Clip::skeleton_bytes() const noexcept { return image_ ? image_->skeleton_bytes() : 0; }
 size_t Clip::animation_bytes() const noexcept { return image_ ? image_->animation_bytes() : 0; }
+uint64_t Clip::rig_hash() const noexcept { return KEYANIM_IMG.rig->hash; }
+bool Clip::shares_rig(const Clip& other) const noexcept { return KEYANIM_IMG.rig == ClipAccess::image(other).rig; }
 
 double Clip::duration() const noexcept {
   const Image& img = KEYANIM_IMG;
@@ -150,7 +163,7 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
                           PositionReading reading) const noexcept {
   if (std::isnan(frame_position)) return Status::invalid_argument;
   const Image& img = KEYANIM_IMG;
-  const uint32_t nodes = static_cast<uint32_t>(img.skeleton.joints.size());
+  const uint32_t nodes = static_cast<uint32_t>(img.rig->skeleton.joints.size());
   if (out.size() < nodes) return Status::output_too_small;
   const float f = static_cast<float>(frame_position);
   if (cursor != nullptr) {
@@ -169,7 +182,7 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
     internal::local_transforms(img, 0, nodes, values, reading, out.data());
     return Status::ok;
   }
-  const auto& joints = img.skeleton.joints;
+  const auto& joints = img.rig->skeleton.joints;
   for (uint32_t first = 0; first < nodes;) {
     uint32_t last = first;
     const uint32_t column = joints[first].first_channel;

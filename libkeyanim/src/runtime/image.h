@@ -32,6 +32,11 @@
 #include "internal/format.h"
 #include "keyanim/cardinal.h"
 #include "keyanim/skeleton.h"
+#include "runtime/rig.h"
+
+namespace keyanim {
+class RigCache;
+}
 
 namespace keyanim::internal {
 
@@ -57,26 +62,9 @@ struct Image {
   uint32_t frame_count = 0;
   double frame_time = 0.0;
   TangentRule rule = TangentRule::step_adjusted;
-  Skeleton skeleton;
-  // Poses (pose.cpp). node_offset: 4 per node, its OFFSET in binary32 and a 0 (Transform's
-  // translation and reserved, one copy). Rotations: nodes are grouped by the axes of their
-  // rotation channels in order (Z X Y for most BVH joints, none for End Sites), so that 4 nodes
-  // of a group become quaternions in one register per component, one step per channel.
-  // Positions: every position channel, in node order.
-  struct RotationGroup {
-    uint32_t node_first, node_count;  // its nodes: group_node[node_first ..), in increasing order
-    uint32_t column_first;            // step k's columns: group_column[column_first + k * node_count ..)
-    uint32_t steps;                   // rotation channels per node (<= kMaxNodeChannels)
-    uint8_t axis[kMaxNodeChannels];   // their axes in composition order: 0 X, 1 Y, 2 Z
-  };
-  struct Move {
-    uint32_t node, column;
-    uint32_t axis;  // 0 X, 1 Y, 2 Z
-  };
-  std::vector<float> node_offset;
-  std::vector<RotationGroup> rot_groups;
-  std::vector<uint32_t> group_node, group_column;
-  std::vector<Move> moves;
+  // The rig (rig.h): skeleton and pose tables, shared by the clips of one rig loaded through
+  // one RigCache. Never null in a built image.
+  std::shared_ptr<const Rig> rig;
   std::string notes;
   uint64_t total_keys = 0;
   uint64_t id = 0;  // distinguishes clips for cursors (an address can be reused)
@@ -112,13 +100,14 @@ struct Image {
   const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
     return payload.data() + record_offset[size_t(block) * block_curves + curve];
   }
-  size_t skeleton_bytes() const noexcept;   // the rig's part (image_build.cpp)
-  size_t animation_bytes() const noexcept;  // the rest
+  size_t skeleton_bytes() const noexcept { return rig->bytes(); }  // the rig's part
+  size_t animation_bytes() const noexcept;  // the rest (image_build.cpp)
   size_t memory_bytes() const noexcept { return skeleton_bytes() + animation_bytes(); }
 };
 
-// Builds the image of a valid source (its keys decoded, every rule checked).
-std::shared_ptr<const Image> build_image(ClipSource&& source);
+// Builds the image of a valid source (its keys decoded, every rule checked). With `rigs`, the
+// skeleton is the cache's rig when it holds an equal one (rig.h).
+std::shared_ptr<const Image> build_image(ClipSource&& source, RigCache* rigs = nullptr);
 // Whether a curve of n keys over `blocks` blocks is kept as a list (see Image::curves).
 inline bool is_list_curve(uint64_t n, uint64_t blocks) noexcept { return 4 * n < blocks; }
 

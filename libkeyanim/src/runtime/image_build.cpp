@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "runtime/image.h"
+#include "runtime/rig_cache_access.h"
 
 namespace keyanim::internal {
 namespace {
@@ -101,60 +102,9 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
     w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
 }
 
-// The pose tables (Image::node_offset, rot_groups, moves): nodes grouped by their rotation
-// axes in order of first appearance, each group's columns step by step.
-void build_pose_tables(Image& img) {
-  std::vector<std::vector<uint32_t>> members;  // per group, its nodes
-  const auto& joints = img.skeleton.joints;
-  for (uint32_t node = 0; node < joints.size(); ++node) {
-    const Joint& j = joints[node];
-    for (double o : j.offset) img.node_offset.push_back(static_cast<float>(o));
-    img.node_offset.push_back(0.0f);
-    Image::RotationGroup key{};
-    for (size_t k = 0; k < j.channels.size(); ++k) {
-      const uint32_t column = j.first_channel + static_cast<uint32_t>(k);
-      const uint32_t axis = static_cast<uint32_t>(channel_axis(j.channels[k]));
-      if (is_rotation(j.channels[k]))
-        key.axis[key.steps++] = static_cast<uint8_t>(axis);
-      else
-        img.moves.push_back({node, column, axis});
-    }
-    auto same = [&](const Image::RotationGroup& g) {
-      return g.steps == key.steps && std::equal(g.axis, g.axis + g.steps, key.axis);
-    };
-    const size_t g = size_t(std::find_if(img.rot_groups.begin(), img.rot_groups.end(), same) - img.rot_groups.begin());
-    if (g == img.rot_groups.size()) {
-      img.rot_groups.push_back(key);
-      members.emplace_back();
-    }
-    members[g].push_back(node);
-  }
-  for (size_t i = 0; i < img.rot_groups.size(); ++i) {
-    Image::RotationGroup& g = img.rot_groups[i];
-    g.node_first = static_cast<uint32_t>(img.group_node.size());
-    g.node_count = static_cast<uint32_t>(members[i].size());
-    g.column_first = static_cast<uint32_t>(img.group_column.size());
-    img.group_node.insert(img.group_node.end(), members[i].begin(), members[i].end());
-    for (uint32_t k = 0; k < g.steps; ++k)
-      for (uint32_t node : members[i]) {
-        const Joint& j = joints[node];
-        uint32_t seen = 0;  // the node's k-th rotation channel
-        for (size_t c = 0; c < j.channels.size(); ++c)
-          if (is_rotation(j.channels[c]) && seen++ == k) img.group_column.push_back(j.first_channel + uint32_t(c));
-      }
-  }
-}
-
 // The arrays were grown by push_back: give back what they reserved beyond their size (up to
 // half of each), since a loaded clip lives long.
 void shrink(Image& img) {
-  img.skeleton.joints.shrink_to_fit();
-  for (Joint& j : img.skeleton.joints) j.name.shrink_to_fit(), j.channels.shrink_to_fit();
-  img.node_offset.shrink_to_fit();
-  img.rot_groups.shrink_to_fit();
-  img.group_node.shrink_to_fit();
-  img.group_column.shrink_to_fit();
-  img.moves.shrink_to_fit();
   img.fixed_channels.shrink_to_fit();
   img.curves.shrink_to_fit();
   img.list_frames.shrink_to_fit();
@@ -166,26 +116,7 @@ void shrink(Image& img) {
   img.notes.shrink_to_fit();
 }
 
-// The skeleton's nodes: the array, names beyond the small-string buffer, channel lists.
-size_t joints_bytes(const Skeleton& skeleton) noexcept {
-  size_t n = skeleton.joints.capacity() * sizeof(Joint);
-  for (const Joint& j : skeleton.joints) {
-    n += j.name.capacity() > 15 ? j.name.capacity() : 0;
-    n += j.channels.capacity() * sizeof(ChannelType);
-  }
-  return n;
-}
-
 }  // namespace
-
-// The rig: what every clip of one skeleton holds alike (names, parents, OFFSETs, channel lists,
-// the pose tables built from them). An engine holding many clips of one rig needs it once.
-size_t Image::skeleton_bytes() const noexcept {
-  size_t n = joints_bytes(skeleton);
-  n += node_offset.capacity() * sizeof(float) + rot_groups.capacity() * sizeof(RotationGroup) +
-       (group_node.capacity() + group_column.capacity()) * sizeof(uint32_t) + moves.capacity() * sizeof(Move);
-  return n;
-}
 
 // The motion: keys, per-channel and per-curve facts, records, notes, and the image itself.
 size_t Image::animation_bytes() const noexcept {
@@ -202,15 +133,14 @@ size_t Image::animation_bytes() const noexcept {
   return n;
 }
 
-std::shared_ptr<const Image> build_image(ClipSource&& src) {
+std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
   auto img = std::make_shared<Image>();
   img->version_major = src.version_major;
   img->version_minor = src.version_minor;
   img->frame_count = src.frame_count;
   img->frame_time = src.frame_time;
   img->rule = src.rule;
-  img->skeleton = std::move(src.skeleton);
-  build_pose_tables(*img);
+  img->rig = rigs != nullptr ? RigCacheAccess::intern(*rigs, std::move(src.skeleton)) : make_rig(std::move(src.skeleton));
   img->notes = std::move(src.notes);
   img->total_keys = src.frames.size();
   static std::atomic<uint64_t> next_id{1};

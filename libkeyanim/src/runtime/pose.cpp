@@ -33,7 +33,7 @@ inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
 }
 
 // The rotations of a group's nodes [begin, end) (indices into the group), out[node - first].
-void group_rotations(const Image& img, const Image::RotationGroup& g, uint32_t begin, uint32_t end,
+void group_rotations(const Rig& img, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
                      const float* values, uint32_t column0, uint32_t first, Transform* out) noexcept {
   const uint32_t* node = img.group_node.data() + g.node_first;
   for (uint32_t i = begin; i < end; i += 4) {
@@ -106,35 +106,36 @@ inline void multiply(const float* a, const float* b, float* out) noexcept {
 #endif
 
 static_assert(offsetof(Transform, reserved) == offsetof(Transform, translation) + 3 * sizeof(float),
-              "a node's translation and reserved are one 4-float copy of Image::node_offset");
+              "a node's translation and reserved are one 4-float copy of Rig::node_offset");
 
 }  // namespace
 
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
                       Transform* out) noexcept {
   if (first >= last) return;
-  const uint32_t column0 = img.skeleton.joints[first].first_channel;  // values[0]'s column
+  const Rig& rig = *img.rig;
+  const uint32_t column0 = rig.skeleton.joints[first].first_channel;  // values[0]'s column
   // Translations: OFFSETs (and reserved = 0), then the position channels.
   for (uint32_t node = first; node < last; ++node)
-    std::memcpy(out[node - first].translation, img.node_offset.data() + 4 * size_t(node), 4 * sizeof(float));
-  const Image::Move* moves = img.moves.data();
-  const auto by_node = [](const Image::Move& m, uint32_t node) { return m.node < node; };
-  const Image::Move* m = std::lower_bound(moves, moves + img.moves.size(), first, by_node);
-  for (; m != moves + img.moves.size() && m->node < last; ++m) {
+    std::memcpy(out[node - first].translation, rig.node_offset.data() + 4 * size_t(node), 4 * sizeof(float));
+  const Rig::Move* moves = rig.moves.data();
+  const auto by_node = [](const Rig::Move& m, uint32_t node) { return m.node < node; };
+  const Rig::Move* m = std::lower_bound(moves, moves + rig.moves.size(), first, by_node);
+  for (; m != moves + rig.moves.size() && m->node < last; ++m) {
     const float v = values[m->column - column0];
     float& t = out[m->node - first].translation[m->axis];
-    t = reading == PositionReading::add ? img.node_offset[4 * size_t(m->node) + m->axis] + v : v;
+    t = reading == PositionReading::add ? rig.node_offset[4 * size_t(m->node) + m->axis] + v : v;
   }
   // Rotations, group by group: the group's nodes in [first, last).
-  for (const Image::RotationGroup& g : img.rot_groups) {
-    const uint32_t* node = img.group_node.data() + g.node_first;
+  for (const Rig::RotationGroup& g : rig.rot_groups) {
+    const uint32_t* node = rig.group_node.data() + g.node_first;
     const uint32_t begin = lower_index(node, g.node_count, first), end = lower_index(node, g.node_count, last);
-    group_rotations(img, g, begin, end, values, column0, first, out);
+    group_rotations(rig, g, begin, end, values, column0, first, out);
   }
 }
 
 void compose_model(const Image& img, Transform* out) noexcept {
-  const auto& joints = img.skeleton.joints;
+  const auto& joints = img.rig->skeleton.joints;
   for (size_t i = 0; i < joints.size(); ++i) {
     const int32_t p = joints[i].parent;
     if (p < 0) continue;  // parents come first: out[p] is already in model space

@@ -171,6 +171,9 @@ nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& c
   j["memory_bytes"] = clip.memory_bytes();
   j["skeleton_bytes"] = clip.skeleton_bytes();  // once per rig in an engine
   j["animation_bytes"] = clip.animation_bytes();
+  char hash[19];  // a string: JSON readers keep 53 bits of a number
+  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(clip.rig_hash()));
+  j["rig_hash"] = hash;  // equal for clips of one rig (Clip::rig_hash)
   j["encoder_notes"] = clip.encoder_notes();
   if (nlohmann::json noted = guarantee_json(clip.encoder_notes()); !noted.empty()) j["guarantee"] = noted;
   return j;

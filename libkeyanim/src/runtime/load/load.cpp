@@ -54,7 +54,8 @@ Status Loader::run(ClipSource& parts) {
 using internal::ClipSource;
 using internal::Loader;
 
-Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits) {
+Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits,
+                  RigCache* rigs) {
   out = Clip{};
   if (err != nullptr) *err = ErrorInfo{};
   try {
@@ -62,7 +63,7 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
     Loader loader(bytes, limits, err);
     const Status s = loader.run(parts);
     if (s != Status::ok) return s;
-    out = ClipAccess::make(internal::build_image(std::move(parts)));
+    out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
   } catch (const std::bad_alloc&) {
     out = Clip{};
     if (err != nullptr) {
@@ -76,7 +77,8 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
   return Status::ok;
 }
 
-Status Clip::load_file(const std::string& path, Clip& out, ErrorInfo* err, const DecodeLimits& limits) {
+Status Clip::load_file(const std::string& path, Clip& out, ErrorInfo* err, const DecodeLimits& limits,
+                       RigCache* rigs) {
   out = Clip{};
   auto io_fail = [&](Status s, std::string detail) {
     if (err != nullptr) *err = ErrorInfo{s, 0, "file", path + ": " + detail};
@@ -97,7 +99,7 @@ Status Clip::load_file(const std::string& path, Clip& out, ErrorInfo* err, const
   }
   if (!bytes.empty() && std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size())
     return io_fail(Status::io_error, "read error");
-  return load(bytes, out, err, limits);
+  return load(bytes, out, err, limits, rigs);
 }
 
 }  // namespace keyanim

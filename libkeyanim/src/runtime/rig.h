@@ -1,0 +1,50 @@
+// A rig: the skeleton of a loaded clip and the pose tables built from it. Every clip of one
+// character has the same one, so clips loaded through one RigCache (keyanim/clip.h) share a
+// single Rig instead of holding a copy each. Internal to the runtime.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "internal/format.h"
+#include "keyanim/skeleton.h"
+
+namespace keyanim::internal {
+
+struct Rig {
+  Skeleton skeleton;
+  uint64_t hash = 0;  // rig_hash(skeleton)
+  // Poses (pose.cpp). node_offset: 4 per node, its OFFSET in binary32 and a 0 (Transform's
+  // translation and reserved, one copy). Rotations: nodes are grouped by the axes of their
+  // rotation channels in order (Z X Y for most BVH joints, none for End Sites), so that 4 nodes
+  // of a group become quaternions in one register per component, one step per channel.
+  // Positions: every position channel, in node order.
+  struct RotationGroup {
+    uint32_t node_first, node_count;  // its nodes: group_node[node_first ..), in increasing order
+    uint32_t column_first;            // step k's columns: group_column[column_first + k * node_count ..)
+    uint32_t steps;                   // rotation channels per node (<= kMaxNodeChannels)
+    uint8_t axis[kMaxNodeChannels];   // their axes in composition order: 0 X, 1 Y, 2 Z
+  };
+  struct Move {
+    uint32_t node, column;
+    uint32_t axis;  // 0 X, 1 Y, 2 Z
+  };
+  std::vector<float> node_offset;
+  std::vector<RotationGroup> rot_groups;
+  std::vector<uint32_t> group_node, group_column;
+  std::vector<Move> moves;
+
+  size_t bytes() const noexcept;  // everything the rig holds, itself included
+};
+
+// 64-bit FNV-1a of what makes two skeletons one rig: per node its name, parent, OFFSET bits,
+// End Site flag and channel list, in node order. Equal skeletons have equal hashes; clips are
+// shared only after a full comparison (same_rig), so a collision costs memory, never a pose.
+uint64_t rig_hash(const Skeleton& skeleton) noexcept;
+bool same_rig(const Skeleton& a, const Skeleton& b) noexcept;
+
+// The rig of `skeleton`: its pose tables built, its arrays shrunk to size.
+std::shared_ptr<const Rig> make_rig(Skeleton&& skeleton);
+
+}  // namespace keyanim::internal
