@@ -6,6 +6,7 @@
 #include <limits>
 #include <new>
 
+#include "internal/cpu.h"
 #include "internal/simd.h"
 #include "runtime/clip_access.h"
 #include "runtime/cursor_state.h"
@@ -93,9 +94,7 @@ void refresh(const Image& img, Cursor::State& st, uint32_t i, float f) noexcept 
   }
 }
 
-}  // namespace
-
-void sample_playback(const Image& img, Cursor::State& st, float f, float* out) noexcept {
+KEYANIM_INLINE inline void playback_impl(const Image& img, Cursor::State& st, float f, float* out) noexcept {
   const uint32_t n = static_cast<uint32_t>(img.curves.size());
   const F4 fv(f);
   // Which curves left their segment, 4 at a time.
@@ -115,6 +114,20 @@ void sample_playback(const Image& img, Cursor::State& st, float f, float* out) n
   const uint32_t* channel = img.curve_channel.data();
   for (uint32_t i = 0; i < n; ++i) out[channel[i]] = st.result[i];
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
+}
+
+// One copy per CPU level (internal/cpu.h).
+KEYANIM_V3_TARGET void playback_v3(const Image& img, Cursor::State& st, float f, float* out) noexcept {
+  playback_impl(img, st, f, out);
+}
+void playback_plain(const Image& img, Cursor::State& st, float f, float* out) noexcept {
+  playback_impl(img, st, f, out);
+}
+
+}  // namespace
+
+void sample_playback(const Image& img, Cursor::State& st, float f, float* out) noexcept {
+  cpu_level() == CpuLevel::v3 ? playback_v3(img, st, f, out) : playback_plain(img, st, f, out);
 }
 
 }  // namespace internal

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstring>
 
+#include "internal/cpu.h"
 #include "internal/trig.h"
 
 namespace keyanim::internal {
@@ -24,7 +25,7 @@ struct Quat4 {
 //   Y: (x c - z s, y c + w s, z c + x s, w c - y s)
 //   Z: (x c + y s, y c - x s, z c + w s, w c - z s).
 // The axis is the same in every lane (a group's), so the choice is made once for four nodes.
-inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
+KEYANIM_INLINE inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
   switch (axis) {
     case 0: return {q.x * c + q.w * s, q.y * c + q.z * s, q.z * c - q.y * s, q.w * c - q.x * s};
     case 1: return {q.x * c - q.z * s, q.y * c + q.w * s, q.z * c + q.x * s, q.w * c - q.y * s};
@@ -33,7 +34,7 @@ inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
 }
 
 // The rotations of a group's nodes [begin, end) (indices into the group), out[node - first].
-void group_rotations(const Rig& img, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
+KEYANIM_INLINE inline void group_rotations(const Rig& img, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
                      const float* values, uint32_t column0, uint32_t first, Transform* out) noexcept {
   const uint32_t* node = img.group_node.data() + g.node_first;
   for (uint32_t i = begin; i < end; i += 4) {
@@ -54,7 +55,7 @@ void group_rotations(const Rig& img, const Rig::RotationGroup& g, uint32_t begin
 }
 
 // The first index of `sorted` (ascending, n entries) whose value is >= x.
-inline uint32_t lower_index(const uint32_t* sorted, uint32_t n, uint32_t x) noexcept {
+KEYANIM_INLINE inline uint32_t lower_index(const uint32_t* sorted, uint32_t n, uint32_t x) noexcept {
   return static_cast<uint32_t>(std::lower_bound(sorted, sorted + n, x) - sorted);
 }
 
@@ -86,7 +87,7 @@ template <int a, int b, int c, int d>
 }
 #else
 // v rotated by unit quaternion q: v + 2 w (u x v) + 2 u x (u x v), u = q.xyz.
-inline void rotate_vector(const float* q, const float* v, float* out) noexcept {
+KEYANIM_INLINE inline void rotate_vector(const float* q, const float* v, float* out) noexcept {
   const float tx = 2.0f * (q[1] * v[2] - q[2] * v[1]);
   const float ty = 2.0f * (q[2] * v[0] - q[0] * v[2]);
   const float tz = 2.0f * (q[0] * v[1] - q[1] * v[0]);
@@ -96,7 +97,7 @@ inline void rotate_vector(const float* q, const float* v, float* out) noexcept {
 }
 
 // a * b (Hamilton product).
-inline void multiply(const float* a, const float* b, float* out) noexcept {
+KEYANIM_INLINE inline void multiply(const float* a, const float* b, float* out) noexcept {
   const float x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
   const float y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
   const float z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
@@ -108,11 +109,8 @@ inline void multiply(const float* a, const float* b, float* out) noexcept {
 static_assert(offsetof(Transform, reserved) == offsetof(Transform, translation) + 3 * sizeof(float),
               "a node's translation and reserved are one 4-float copy of Rig::node_offset");
 
-}  // namespace
-
-void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
-                      Transform* out) noexcept {
-  if (first >= last) return;
+KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t last, const float* values,
+                                     PositionReading reading, Transform* out) noexcept {
   const Rig& rig = *img.rig;
   const uint32_t column0 = rig.skeleton.joints[first].first_channel;  // values[0]'s column
   // Translations: OFFSETs (and reserved = 0), then the position channels.
@@ -134,7 +132,7 @@ void local_transforms(const Image& img, uint32_t first, uint32_t last, const flo
   }
 }
 
-void compose_model(const Image& img, Transform* out) noexcept {
+KEYANIM_INLINE inline void compose_impl(const Image& img, Transform* out) noexcept {
   const auto& joints = img.rig->skeleton.joints;
   for (size_t i = 0; i < joints.size(); ++i) {
     const int32_t p = joints[i].parent;
@@ -155,6 +153,31 @@ void compose_model(const Image& img, Transform* out) noexcept {
     std::copy(q, q + 4, t.rotation);
 #endif
   }
+}
+
+// One copy per CPU level (internal/cpu.h).
+KEYANIM_V3_TARGET void local_v3(const Image& img, uint32_t first, uint32_t last, const float* values,
+                                PositionReading reading, Transform* out) noexcept {
+  local_impl(img, first, last, values, reading, out);
+}
+void local_plain(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
+                 Transform* out) noexcept {
+  local_impl(img, first, last, values, reading, out);
+}
+KEYANIM_V3_TARGET void compose_v3(const Image& img, Transform* out) noexcept { compose_impl(img, out); }
+void compose_plain(const Image& img, Transform* out) noexcept { compose_impl(img, out); }
+
+}  // namespace
+
+void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
+                      Transform* out) noexcept {
+  if (first >= last) return;
+  cpu_level() == CpuLevel::v3 ? local_v3(img, first, last, values, reading, out)
+                              : local_plain(img, first, last, values, reading, out);
+}
+
+void compose_model(const Image& img, Transform* out) noexcept {
+  cpu_level() == CpuLevel::v3 ? compose_v3(img, out) : compose_plain(img, out);
 }
 
 }  // namespace keyanim::internal

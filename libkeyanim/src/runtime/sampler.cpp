@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 
+#include "internal/cpu.h"
 #include "internal/simd.h"
 
 namespace keyanim::internal {
@@ -176,7 +177,8 @@ void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept
 // Pass two: Appendix A for lanes [0, count) rounded up to 4. The frames and values of 4 lanes
 // are transposed into k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2} vectors.
 template <bool kAdjusted>
-void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count, float* res) noexcept {
+KEYANIM_INLINE inline void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count,
+                                   float* res) noexcept {
   const F4 f(at.f), rel(at.rel);
   for (uint32_t i = 0; i < count; i += 4) {
     I4 km = I4::load(b.frames[i]), kj = I4::load(b.frames[i + 1]), kp = I4::load(b.frames[i + 2]),
@@ -201,8 +203,8 @@ void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count
   }
 }
 
-void evaluate(const Image& img, const Batch& b, const Facts& x, const Position& at, uint32_t count,
-              float* res) noexcept {
+KEYANIM_INLINE inline void evaluate(const Image& img, const Batch& b, const Facts& x, const Position& at,
+                                   uint32_t count, float* res) noexcept {
   if (img.rule == TangentRule::step_adjusted)
     evaluate<true>(b, x, at, count, res);
   else
@@ -237,7 +239,7 @@ template <class Fill, class FactsOf, class Emit>
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void sample_chunks(const Image& img, float f, const uint32_t* channels, uint32_t count,
                                                  float* out) noexcept {
-  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
+  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
     for (uint32_t i = 0; i < m; ++i) {
       const uint32_t c = channels[base + i];
       const uint32_t curve = img.curve_of[c];
@@ -252,8 +254,10 @@ template <bool kPopcnt>
       copy_facts(img, curve, b, i);
     }
   };
-  auto facts = [](const Batch& b, uint32_t) { return batch_facts(b); };
-  auto emit = [&](const float* res, uint32_t base, uint32_t m) { std::memcpy(out + base, res, m * sizeof(float)); };
+  auto facts = [](const Batch& b, uint32_t) KEYANIM_INLINE { return batch_facts(b); };
+  auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
+    std::memcpy(out + base, res, m * sizeof(float));
+  };
   run_chunks(img, f, count, fill, facts, emit);
 }
 
@@ -262,7 +266,7 @@ template <bool kPopcnt>
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
-  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) {
+  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
     for (uint32_t i = 0; i < blocked; ++i) {
       // The record a few curves ahead: its address needs a load first, so a cold clip's misses
@@ -273,34 +277,26 @@ template <bool kPopcnt>
     }
     for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
   };
-  auto facts = [&](const Batch&, uint32_t base) {
+  auto facts = [&](const Batch&, uint32_t base) KEYANIM_INLINE {
     return Facts{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
                  img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
   };
-  auto emit = [&](const float* res, uint32_t base, uint32_t m) {
+  auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
     const uint32_t* channel = img.curve_channel.data() + base;
     for (uint32_t i = 0; i < m; ++i) out[channel[i]] = res[i];
   };
   run_chunks(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
 }
 
-// The popcnt instruction is not part of baseline x86-64: the same code is compiled twice and
-// chosen once per process. Results are identical (integer operations).
-#if defined(__x86_64__) && !defined(__POPCNT__)
-#define KEYANIM_POPCNT_TARGET [[gnu::target("popcnt")]]
-bool has_popcnt() noexcept {
-  static const bool yes = __builtin_cpu_supports("popcnt");
-  return yes;
-}
-#else
-#define KEYANIM_POPCNT_TARGET
-bool has_popcnt() noexcept { return true; }
-#endif
-
+// One copy per CPU level (internal/cpu.h); popcnt from the popcnt level on.
+KEYANIM_V3_TARGET void all_v3(const Image& img, float f, float* out) noexcept { sample_curves<true>(img, f, out); }
 KEYANIM_POPCNT_TARGET void all_popcnt(const Image& img, float f, float* out) noexcept {
   sample_curves<true>(img, f, out);
 }
 void all_plain(const Image& img, float f, float* out) noexcept { sample_curves<false>(img, f, out); }
+KEYANIM_V3_TARGET void listed_v3(const Image& img, float f, const uint32_t* ch, uint32_t n, float* out) noexcept {
+  sample_chunks<true>(img, f, ch, n, out);
+}
 KEYANIM_POPCNT_TARGET void listed_popcnt(const Image& img, float f, const uint32_t* ch, uint32_t n,
                                          float* out) noexcept {
   sample_chunks<true>(img, f, ch, n, out);
@@ -312,11 +308,19 @@ void listed_plain(const Image& img, float f, const uint32_t* ch, uint32_t n, flo
 }  // namespace
 
 void sample_all(const Image& img, float f, float* out) noexcept {
-  has_popcnt() ? all_popcnt(img, f, out) : all_plain(img, f, out);
+  switch (cpu_level()) {
+    case CpuLevel::v3: return all_v3(img, f, out);
+    case CpuLevel::popcnt: return all_popcnt(img, f, out);
+    default: return all_plain(img, f, out);
+  }
 }
 
 void sample_listed(const Image& img, float f, const uint32_t* channels, uint32_t count, float* out) noexcept {
-  has_popcnt() ? listed_popcnt(img, f, channels, count, out) : listed_plain(img, f, channels, count, out);
+  switch (cpu_level()) {
+    case CpuLevel::v3: return listed_v3(img, f, channels, count, out);
+    case CpuLevel::popcnt: return listed_popcnt(img, f, channels, count, out);
+    default: return listed_plain(img, f, channels, count, out);
+  }
 }
 
 void sample_range(const Image& img, float f, uint32_t first, uint32_t count, float* out) noexcept {
