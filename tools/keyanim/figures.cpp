@@ -155,16 +155,19 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   const bool whole = first == 0 && last == n - 1;
   const std::string shown = whole ? "" : " (frames " + std::to_string(first) + "-" + std::to_string(last) + ")";
 
-  svg::Document doc(960, 440);
+  const std::string heading =
+      file_label + "  " + spec + shown + "  \xE2\x80\x94  keys: " + settings_text(settings, result.tolerance_units);
+  const std::string subheading = count_of(out.channel_keys, "key") + " on this channel (" + count_of(n, "frame") + "), " +
+                                 std::to_string(result.total_keys) + " in the clip; max channel error " +
+                                 short_number(out.max_channel_error) + " " + unit + "; max joint error " +
+                                 short_number(result.error.max_error) + " file units";
+  // Wider than the plot when the heading needs it (a long file name), never clipped.
+  const double width = std::max({960.0, area.x + svg::text_width(heading, 14, true) + 24, area.x + svg::text_width(subheading) + 24});
+  svg::Document doc(width, 440);
   const svg::Axes axes(area, {double(first), double(last)}, svg::nice_range({lo - pad, hi + pad}, 6));
   doc.title(file_label + " " + spec + ": original and reconstruction" + shown);
-  doc.text({84, 22}, file_label + "  " + spec + shown + "  \xE2\x80\x94  keys: " + settings_text(settings, result.tolerance_units),
-           attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
-  doc.text({84, 40}, count_of(out.channel_keys, "key") + " on this channel (" + count_of(n, "frame") + "), " +
-                         std::to_string(result.total_keys) + " in the clip; max channel error " +
-                         short_number(out.max_channel_error) + " " + unit + "; max joint error " +
-                         short_number(result.error.max_error) + " file units",
-           attr("class", "subtitle") + " fill=\"#444\"");
+  doc.text({84, 22}, heading, attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
+  doc.text({84, 40}, subheading, attr("class", "subtitle") + " fill=\"#444\"");
   axes.draw(doc, "frame", std::string(channel_name(type)) + " (" + unit + ")", 10, 6);
 
   std::vector<svg::Point> pts;
@@ -232,7 +235,17 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
   const double scale = std::min(440.0 / hu, 380.0 / wu);
   const double panel_w = std::max(260.0, wu * scale), panel_h = std::max(260.0, hu * scale);
   const double left = 78, gap = 96, top = 96, right = 24, bottom = 56;
-  const double width = left + 2 * panel_w + gap + right, height = top + panel_h + bottom;
+  std::vector<svg::LegendEntry> entries;
+  for (size_t s = 0; s < series.size() && s < 2; ++s) entries.push_back({series[s].label, kPoseColours[s], true, s == 0 ? 3.0 : 1.6});
+  const Skeleton& sk = series.front().motion->skeleton;
+  const std::string subtitle = series.size() == 2 ? "largest distance: " + offline::node_name(sk, fig.worst_node) + " " +
+                                                        short_number(fig.worst_distance) + " file units"
+                                                  : "";
+  // Wide enough for the two views, and for the title, the legend and the subtitle above them
+  // (a title naming two long files was cut off).
+  const double width = std::max({left + 2 * panel_w + gap + right, left + svg::text_width(title, 14, true) + right,
+                                 left + svg::legend_width(entries) + right, left + svg::text_width(subtitle) + right});
+  const double height = top + panel_h + bottom;
   auto centred = [&](int axis, double pixels) {
     const double c = (lo[axis] + hi[axis]) / 2, half = pixels / scale / 2;
     return svg::Range{c - half, c + half};
@@ -244,14 +257,8 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
   svg::Document doc(width, height);
   doc.title(title);
   doc.text({left, 22}, title, attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
-  std::vector<svg::LegendEntry> entries;
-  for (size_t s = 0; s < series.size() && s < 2; ++s) entries.push_back({series[s].label, kPoseColours[s], true, s == 0 ? 3.0 : 1.6});
   svg::legend(doc, {left, 44}, entries);
-  const Skeleton& sk = series.front().motion->skeleton;
-  if (series.size() == 2)
-    doc.text({left, 64}, "largest distance: " + offline::node_name(sk, fig.worst_node) + " " +
-                             short_number(fig.worst_distance) + " file units",
-             attr("class", "subtitle") + " fill=\"#444\"");
+  if (series.size() == 2) doc.text({left, 64}, subtitle, attr("class", "subtitle") + " fill=\"#444\"");
 
   const struct {
     const svg::Axes* axes;
