@@ -1,6 +1,6 @@
 // The up axis of a skeleton, and the turn that shows a z-up file upright in the viewer's y-up
 // space. BVH does not say which axis is up: CMU, Bandai and most files are y-up, MakeHuman's
-// exports z-up. The rule (the same as `keyanim render`'s, tools/keyanim/up_axis.cpp): in the
+// exports z-up. The rule (the same as `keyanim render`'s, tools/keyanim/conventions.cpp): in the
 // rest pose (every Offset, no channel), a body is taller than it is deep, so the axis of y and z
 // along which the skeleton spans more is up; when neither spans 1.5 times the other the file is
 // ambiguous and y is taken.
