@@ -1,7 +1,8 @@
 // The page: opening files (picker, drag and drop, embedded by `keyanim view`), playback, and
 // the panels. A .kanim is shown decoded, with its original BVH overlaid when one is opened; a
-// BVH opened alone is played by itself (its frames, nearest frame between them). Decoding is the keyanim-three package's (packages/keyanim-three/src/decoder/);
-// drawing is view3d.js and curves.js.
+// BVH opened alone is played by itself (its frames, nearest frame between them). Decoding is
+// the keyanim-three package's (packages/keyanim-three/src/decoder/); drawing is view3d.js and
+// curves.js; what the camera follows and frames, framing.js; the up axis, upaxis.js.
 import { decodeKanim, looksLikeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
 import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { parseBvh } from './bvh.js';
