@@ -79,10 +79,12 @@ export const VIEW_DIRECTION = [0.8, 0.35, 1.5];
 // A camera that sees the whole box: looking at its centre along -direction from the distance
 // at which its bounding sphere fits both the vertical field of view (fovDegrees) and the
 // horizontal one (from aspect = width / height), with a 5% margin. `offset` moves the box (the
-// followed point, for the body box). Returns { target, position, radius, distance }.
-export function fitCamera(box, { fovDegrees = 40, aspect = 1, direction = VIEW_DIRECTION, offset = [0, 0, 0] } = {}) {
+// followed point, for the body box); the sphere is at least `minRadius` (a clip of one point,
+// or a figure that never moves, still gets a camera at some distance: the viewer passes a
+// quarter of the skeleton size). Returns { target, position, radius, distance }.
+export function fitCamera(box, { fovDegrees = 40, aspect = 1, direction = VIEW_DIRECTION, offset = [0, 0, 0], minRadius = 0 } = {}) {
   const centre = [0, 1, 2].map((r) => (box.min[r] + box.max[r]) / 2 + offset[r]);
-  const radius = Math.max(1e-9, Math.hypot(...[0, 1, 2].map((r) => (box.max[r] - box.min[r]) / 2)));
+  const radius = Math.max(minRadius, 1e-9, Math.hypot(...[0, 1, 2].map((r) => (box.max[r] - box.min[r]) / 2)));
   const half = (fovDegrees * Math.PI) / 360;
   const halfNarrow = Math.min(half, Math.atan(Math.tan(half) * aspect));
   const distance = (1.05 * radius) / Math.sin(halfNarrow);

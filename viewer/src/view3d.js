@@ -111,8 +111,8 @@ export class View3D {
   // direction is kept (the user's orbit), or the default one the first time.
   frame(extent, followed) {
     const direction = this.framed ? this.camera.position.clone().sub(this.controls.target).toArray() : undefined;
-    const fit = this.follow ? fitCamera(extent.body, { aspect: this.camera.aspect, fovDegrees: this.camera.fov, direction, offset: followed })
-      : fitCamera(extent.world, { aspect: this.camera.aspect, fovDegrees: this.camera.fov, direction });
+    const options = { aspect: this.camera.aspect, fovDegrees: this.camera.fov, direction, minRadius: this.size / 4 };
+    const fit = this.follow ? fitCamera(extent.body, { ...options, offset: followed }) : fitCamera(extent.world, options);
     this.camera.near = Math.min(this.size / 200, fit.distance / 100);
     this.camera.far = Math.max(this.size * 200, (fit.distance + fit.radius) * 4);
     this.camera.position.fromArray(fit.position);

@@ -100,6 +100,15 @@ test("the corpus's Bandai walk: joint_Root alone is a placeholder, every joint f
   assert.deepEqual(bvh.nodes.map((n, i) => e.placeholders[i] ? n.name : null).filter(Boolean), ['joint_Root']);
 });
 
+test('a one-point clip gets a camera at some distance (minRadius), not on the point', () => {
+  const point = { min: [1, 2, 3], max: [1, 2, 3] };
+  const fit = fitCamera(point, { minRadius: 0.5, fovDegrees: FOV, aspect: ASPECT });
+  assert.deepEqual(fit.target, [1, 2, 3]);
+  assert.ok(Math.abs(fit.distance - (1.05 * 0.5) / Math.sin((FOV * Math.PI) / 360)) < 1e-12, `distance ${fit.distance}`);
+  const c = camera(fit);
+  assert.deepEqual(outside(c, [1.2, 2.2, 3], [0, 0, 0], [0]), [], 'a point 0.28 from the target is in view');
+});
+
 test('up axis: y detected on y-up skeletons, z on z-up ones; a z-up clip is shown as its y-up twin', () => {
   const y = parseBvh(bandaiLikeBvh('y')), z = parseBvh(bandaiLikeBvh('z'));
   assert.deepEqual([detectUpAxis(y.nodes).axis, detectUpAxis(y.nodes).ambiguous], ['y', false]);
