@@ -168,6 +168,8 @@ test('a BVH alone plays; a Bandai-like walker stays in the picture; its .kanim t
   assert.match(await page.$eval('#facts', (e) => e.textContent), /formatBVH \(no \.kanim loaded\)frames195/);
   assert.equal(await page.$eval('#empty', (e) => getComputedStyle(e).display), 'none', '"No clip loaded" is hidden');
   await expectSkeletonsDrawn(page, true, undefined, false);
+  // No bone from the placeholder joint_Root to Hips: 17 nodes, 16 links, 15 drawn.
+  assert.deepEqual(await page.evaluate(() => [window.keyanim.nodeNames.length, window.keyanim.app.view.figures.original.bones.length]), [17, 15]);
 
   // In the picture at every tenth frame: following (the default: placeholders may leave), then
   // with following off (every node, joint_Root too).
