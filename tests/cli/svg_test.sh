@@ -58,6 +58,32 @@ render)
   expect_rc 0 "$K" render walk.kanim -o alone.svg
   well_formed alone.svg
   [ "$(n 'class="bone"' alone.svg)" -eq 74 ] || die "render of a .kanim alone: one pose"
+  # Issue 28, item 9: the up axis. A y-up file says nothing about it; its z-up twin (every
+  # OFFSET turned +90 degrees about x) is detected, drawn x-z and y-z, and render says so;
+  # --up y overrides (no note), --up x is refused.
+  expect_rc 0 "$K" render "$WALK" --frame 0 -o y.svg
+  if grep -q 'up axis' "$T/.stderr"; then die "render of a y-up file talks about its up axis"; fi
+  grep -q '>front view (x-y)</text>' y.svg || die "render: y-up front view"
+  awk '$1 == "OFFSET" { printf "OFFSET %s %s %s\n", $2, ($4 == 0 ? 0 : -$4), $3; next } { print }' "$WALK" >zup.bvh
+  expect_rc 0 "$K" render zup.bvh --frame 0 -o z.svg
+  grep -q '^zup.bvh: up axis z, detected: the rest pose spans .* along z and .* along y (--up y to override)$' "$T/.stderr" ||
+    { cat "$T/.stderr" >&2; die "render: no note of the detected up axis"; }
+  grep -q '>front view (x-z)</text>' z.svg && grep -q '>side view (y-z)</text>' z.svg || die "render: z-up views"
+  expect_rc 0 "$K" render zup.bvh --frame 0 --up y -o zy.svg
+  if grep -q 'up axis' "$T/.stderr"; then die "render --up y still notes the axis"; fi
+  grep -q '>front view (x-y)</text>' zy.svg || die "render --up y: x-y view"
+  expect_rc 0 "$K" -q render zup.bvh --frame 0 -o zq.svg
+  [ ! -s "$T/.stderr" ] || die "render -q printed: $(cat "$T/.stderr")"
+  expect_rc 1 "$K" render zup.bvh --up x -o zx.svg
+  grep -q "\-\-up expects y, z or auto, got 'x'" "$T/.stderr" || die "render --up x: no clear error"
+  # The reading: position channels below the root holding deltas (MakeHuman's way) are read as
+  # replace by default, and render says that their bones keep their lengths under add.
+  printf 'HIERARCHY\nROOT r\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n JOINT a\n {\n  OFFSET 0 10 0\n  CHANNELS 3 Xposition Yposition Zposition\n  End Site\n  {\n   OFFSET 0 10 0\n  }\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0 0 0.01 0\n' >deltas.bvh
+  expect_rc 0 "$K" render deltas.bvh -o d.svg
+  grep -q '^deltas.bvh: position channels below the root read as replace (.*); its bones keep their lengths under add .*--position-channels add$' "$T/.stderr" ||
+    { cat "$T/.stderr" >&2; die "render: no note of the reading"; }
+  expect_rc 0 "$K" render deltas.bvh --position-channels add -o da.svg
+  if grep -q 'read as' "$T/.stderr"; then die "render --position-channels add still notes the reading"; fi
   ;;
 exit_codes)
   expect_rc 0 "$K" plot --help

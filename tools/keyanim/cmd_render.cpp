@@ -1,16 +1,20 @@
 // keyanim render: one frame of a skeleton as a stick figure (front and side view), as SVG; by
 // default the original beside (overlaid on) its reconstruction.
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "commands.h"
 #include "escape.h"
 #include "io.h"
+#include "conventions.h"
 #include "figures.h"
 #include "keyanim/clip.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
+#include "keyanim/offline/fk.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
 
@@ -18,10 +22,11 @@ namespace keyanim::cli {
 
 const char* const kRenderHelp =
     "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg]\n"
-    "                      [--position-channels replace|add] [--error E|E%] [--shell D|D%]\n"
-    "                      [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
+    "                      [--position-channels replace|add] [--up y|z|auto] [--error E|E%]\n"
+    "                      [--shell D|D%] [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
-    "file length units. Two poses are overlaid and the joint farthest apart is labelled:\n"
+    "file length units (x-z and y-z for a z-up file). Two poses are overlaid and the joint\n"
+    "farthest apart is labelled:\n"
     "  - with --against OTHER (BVH or .kanim with the same skeleton): IN and OTHER;\n"
     "  - else, for a BVH: the original and its reconstruction, encoded with the encoder options\n"
     "    below and decoded;\n"
@@ -32,9 +37,45 @@ const char* const kRenderHelp =
     "                        '-' = standard output)\n"
     "  --position-channels replace|add\n"
     "                        how position channels below the root combine with OFFSET: replace\n"
-    "                        it (Blender; default) or add to it (three.js)\n";
+    "                        it (Blender; default) or add to it (three.js). When the file has\n"
+    "                        such channels and the option is not given, render says which\n"
+    "                        reading it used and under which the bones keep their lengths\n"
+    "  --up y|z|auto         the file's up axis (default auto: of y and z, the one along which\n"
+    "                        the rest pose spans more; y when neither spans 1.5 times the other).\n"
+    "                        render says which it used when it detected z or could not tell\n";
 
 namespace {
+
+std::optional<UpAxis> up_axis_option(const Args& args) {
+  const std::optional<std::string> v = args.get("--up");
+  if (!v || *v == "auto") return std::nullopt;
+  if (*v == "y") return UpAxis::y;
+  if (*v == "z") return UpAxis::z;
+  fail(kUsage, "--up expects y, z or auto, got '" + *v + "'");
+}
+
+// Three significant digits: "16.6", "4", "0.0123".
+std::string short_length(double v) {
+  std::ostringstream o;
+  o << std::setprecision(3) << v;
+  return o.str();
+}
+
+std::string up_note(const UpGuess& g) {
+  const std::string spans = "the rest pose spans " + short_length(g.extents[2]) + " along z and " + short_length(g.extents[1]) + " along y";
+  if (g.ambiguous) return "up axis y, taken: " + spans + ", too close to tell which is up (--up z for the other)";
+  return "up axis z, detected: " + spans + " (--up y to override)";
+}
+
+// Which reading render used (the default: it was not given) and which keeps the bones rigid.
+std::string reading_note(const offline::Motion& one_frame) {
+  std::string note = "position channels below the root read as replace (Blender's reading, the default)";
+  const std::optional<PositionReading> rigid = rigid_reading(one_frame, 0);
+  if (rigid == PositionReading::add)
+    return note + "; its bones keep their lengths under add (three.js's reading): --position-channels add";
+  if (rigid == PositionReading::replace) return note + ", under which its bones keep their lengths";
+  return note + "; add (three.js's reading) poses it differently: --position-channels add";
+}
 
 // One input's poses: a BVH's motion (all of it: it is no larger than the file), or a clip, of
 // which only the frame drawn is decoded, whatever frame count it declares.
@@ -67,7 +108,7 @@ struct Poses {
 }  // namespace
 
 int cmd_render(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels"};
+  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels", "--up"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {});
   if (args.positional().size() != 1) fail(kUsage, "render takes one input file");
@@ -77,6 +118,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   if (against && *against == "-" && in == "-") fail(kUsage, "only one input can be standard input");
   const uint32_t frame_option = args.get_uint("--frame", 0);  // parsed before any work
   const PositionReading reading = position_reading(args);
+  const std::optional<UpAxis> up_option = up_axis_option(args);
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
@@ -120,7 +162,9 @@ int cmd_render(const Argv& argv, Globals& g) {
     title += ": original and reconstruction";
   }
 
-  const PoseFigure fig = render_pose(series, 0, title, reading);
+  const UpGuess guess = detect_up_axis(first.skeleton);
+  const UpAxis up = up_option.value_or(guess.axis);
+  const PoseFigure fig = render_pose(series, 0, title, reading, up);
   output.write(fig.svg);
   output.commit();
   if (g.verbosity > 0) {
@@ -129,6 +173,10 @@ int cmd_render(const Argv& argv, Globals& g) {
       std::cerr << ", largest distance " << fig.worst_distance << " ("
                 << printable(offline::node_name(first.skeleton, fig.worst_node)) << ")";
     std::cerr << "\n";
+    // What the file leaves open, when render chose it.
+    if (!up_option && (guess.ambiguous || guess.axis == UpAxis::z)) std::cerr << printable(in) << ": " << up_note(guess) << "\n";
+    if (!args.has("--position-channels") && offline::has_position_channels_below_root(first.skeleton))
+      std::cerr << printable(in) << ": " << reading_note(first) << "\n";
   }
   return kOk;
 }

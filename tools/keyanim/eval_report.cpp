@@ -51,7 +51,8 @@ std::vector<Total> totals(const std::vector<nlohmann::json>& files) {
   return out;
 }
 
-// Legend labels: the paths below the inputs' common directory (short, and still unique).
+// Legend labels: the paths below the inputs' common directory (short, and still unique); the
+// figure shortens a label too long for its legend in the middle (rd_plot.h), keeping its end.
 std::vector<std::string> short_names(const std::vector<std::string>& paths) {
   std::string prefix = paths.empty() ? "" : paths[0].substr(0, paths[0].rfind('/') + 1);  // npos + 1: none
   for (const std::string& p : paths) {
@@ -62,9 +63,7 @@ std::vector<std::string> short_names(const std::vector<std::string>& paths) {
   }
   std::vector<std::string> out;
   for (const std::string& p : paths) {
-    std::string name = p.substr(prefix.size());
-    if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
-    out.push_back(name);
+    out.push_back(p.substr(prefix.size()));
   }
   return out;
 }

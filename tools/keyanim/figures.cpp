@@ -155,16 +155,19 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   const bool whole = first == 0 && last == n - 1;
   const std::string shown = whole ? "" : " (frames " + std::to_string(first) + "-" + std::to_string(last) + ")";
 
-  svg::Document doc(960, 440);
+  const std::string heading =
+      file_label + "  " + spec + shown + "  \xE2\x80\x94  keys: " + settings_text(settings, result.tolerance_units);
+  const std::string subheading = count_of(out.channel_keys, "key") + " on this channel (" + count_of(n, "frame") + "), " +
+                                 std::to_string(result.total_keys) + " in the clip; max channel error " +
+                                 short_number(out.max_channel_error) + " " + unit + "; max joint error " +
+                                 short_number(result.error.max_error) + " file units";
+  // Wider than the plot when the heading needs it (a long file name), never clipped.
+  const double width = std::max({960.0, area.x + svg::text_width(heading, 14, true) + 24, area.x + svg::text_width(subheading) + 24});
+  svg::Document doc(width, 440);
   const svg::Axes axes(area, {double(first), double(last)}, svg::nice_range({lo - pad, hi + pad}, 6));
   doc.title(file_label + " " + spec + ": original and reconstruction" + shown);
-  doc.text({84, 22}, file_label + "  " + spec + shown + "  \xE2\x80\x94  keys: " + settings_text(settings, result.tolerance_units),
-           attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
-  doc.text({84, 40}, count_of(out.channel_keys, "key") + " on this channel (" + count_of(n, "frame") + "), " +
-                         std::to_string(result.total_keys) + " in the clip; max channel error " +
-                         short_number(out.max_channel_error) + " " + unit + "; max joint error " +
-                         short_number(result.error.max_error) + " file units",
-           attr("class", "subtitle") + " fill=\"#444\"");
+  doc.text({84, 22}, heading, attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
+  doc.text({84, 40}, subheading, attr("class", "subtitle") + " fill=\"#444\"");
   axes.draw(doc, "frame", std::string(channel_name(type)) + " (" + unit + ")", 10, 6);
 
   std::vector<svg::Point> pts;
@@ -202,7 +205,10 @@ bool same_skeleton(const Skeleton& a, const Skeleton& b) {
 }
 
 PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, const std::string& title,
-                       PositionReading reading) {
+                       PositionReading reading, UpAxis up_axis) {
+  // The vertical world axis of both views, and the horizontal one of the side view (the front
+  // view's is x).
+  const int up = static_cast<int>(up_axis), across = up == 1 ? 2 : 1;
   PoseFigure fig;
   std::vector<std::vector<offline::Vec3>> pos(series.size());
   offline::Vec3 lo{}, hi{};
@@ -225,48 +231,54 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
   }
 
   // One scale for both views and both axes (equal aspect); each view centred on the figure.
-  const double width_units = std::max(hi[0] - lo[0], hi[2] - lo[2]), height_units = hi[1] - lo[1];
+  const double width_units = std::max(hi[0] - lo[0], hi[across] - lo[across]), height_units = hi[up] - lo[up];
   double pad = 0.08 * std::max(width_units, height_units);
   if (!(pad > 0.0)) pad = 1.0;
   const double wu = width_units + 2 * pad, hu = height_units + 2 * pad;
   const double scale = std::min(440.0 / hu, 380.0 / wu);
   const double panel_w = std::max(260.0, wu * scale), panel_h = std::max(260.0, hu * scale);
   const double left = 78, gap = 96, top = 96, right = 24, bottom = 56;
-  const double width = left + 2 * panel_w + gap + right, height = top + panel_h + bottom;
+  std::vector<svg::LegendEntry> entries;
+  for (size_t s = 0; s < series.size() && s < 2; ++s) entries.push_back({series[s].label, kPoseColours[s], true, s == 0 ? 3.0 : 1.6});
+  const Skeleton& sk = series.front().motion->skeleton;
+  const std::string subtitle = series.size() == 2 ? "largest distance: " + offline::node_name(sk, fig.worst_node) + " " +
+                                                        short_number(fig.worst_distance) + " file units"
+                                                  : "";
+  // Wide enough for the two views, and for the title, the legend and the subtitle above them
+  // (a title naming two long files was cut off).
+  const double width = std::max({left + 2 * panel_w + gap + right, left + svg::text_width(title, 14, true) + right,
+                                 left + svg::legend_width(entries) + right, left + svg::text_width(subtitle) + right});
+  const double height = top + panel_h + bottom;
   auto centred = [&](int axis, double pixels) {
     const double c = (lo[axis] + hi[axis]) / 2, half = pixels / scale / 2;
     return svg::Range{c - half, c + half};
   };
-  const svg::Range yr = centred(1, panel_h);
+  const svg::Range yr = centred(up, panel_h);
   const svg::Axes front({left, top, panel_w, panel_h}, centred(0, panel_w), yr);
-  const svg::Axes side({left + panel_w + gap, top, panel_w, panel_h}, centred(2, panel_w), yr);
+  const svg::Axes side({left + panel_w + gap, top, panel_w, panel_h}, centred(across, panel_w), yr);
 
   svg::Document doc(width, height);
   doc.title(title);
   doc.text({left, 22}, title, attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
-  std::vector<svg::LegendEntry> entries;
-  for (size_t s = 0; s < series.size() && s < 2; ++s) entries.push_back({series[s].label, kPoseColours[s], true, s == 0 ? 3.0 : 1.6});
   svg::legend(doc, {left, 44}, entries);
-  const Skeleton& sk = series.front().motion->skeleton;
-  if (series.size() == 2)
-    doc.text({left, 64}, "largest distance: " + offline::node_name(sk, fig.worst_node) + " " +
-                             short_number(fig.worst_distance) + " file units",
-             attr("class", "subtitle") + " fill=\"#444\"");
+  if (series.size() == 2) doc.text({left, 64}, subtitle, attr("class", "subtitle") + " fill=\"#444\"");
 
+  const std::string u(1, "xyz"[up]), a(1, "xyz"[across]);
   const struct {
     const svg::Axes* axes;
     int h;  // horizontal world axis
-    const char* name;
-    const char* x_label;
-  } views[2] = {{&front, 0, "front view (x-y)", "x (file units)"}, {&side, 2, "side view (z-y)", "z (file units)"}};
+    std::string name;
+    std::string x_label;
+  } views[2] = {{&front, 0, "front view (x-" + u + ")", "x (file units)"},
+                {&side, across, "side view (" + a + "-" + u + ")", a + " (file units)"}};
   for (const auto& v : views) {
     const svg::Axes& ax = *v.axes;
-    v.axes->draw(doc, v.x_label, "y (file units)", 5, 6);
+    v.axes->draw(doc, v.x_label, u + " (file units)", 5, 6);
     doc.text({ax.area().x + ax.area().w / 2, top - 8}, v.name, attr("class", "view-title") + " font-weight=\"bold\"",
              "middle");
     for (size_t s = 0; s < series.size() && s < 2; ++s) {
       const Skeleton& k = series[s].motion->skeleton;
-      auto at = [&](uint32_t j) { return ax.at(pos[s][j][v.h], pos[s][j][1]); };
+      auto at = [&](uint32_t j) { return ax.at(pos[s][j][v.h], pos[s][j][up]); };
       doc.open_group(attr("class", "pose pose" + std::to_string(s)) + attr("stroke", kPoseColours[s]) +
                      attr("fill", kPoseColours[s]) + " stroke-linecap=\"round\"" +
                      attr("stroke-width", s == 0 ? "3" : "1.6"));
@@ -279,7 +291,7 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
       doc.close_group();
     }
     if (series.size() == 2 && fig.worst_node < pos[0].size()) {
-      const svg::Point p = ax.at(pos[0][fig.worst_node][v.h], pos[0][fig.worst_node][1]);
+      const svg::Point p = ax.at(pos[0][fig.worst_node][v.h], pos[0][fig.worst_node][up]);
       doc.circle(p, 8.0, attr("class", "worst") + " fill=\"none\" stroke=\"#c00\" stroke-width=\"1.2\"");
       // Beside the circle or in a corner of the view, wherever the label covers least of the
       // figure (joints and points along the bones counted), joined to the circle by a leader line.
@@ -300,10 +312,10 @@ PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, co
         for (size_t s = 0; s < series.size() && s < 2; ++s) {
           const Skeleton& k = series[s].motion->skeleton;
           for (uint32_t j = 0; j < k.joints.size(); ++j) {
-            const svg::Point q = ax.at(pos[s][j][v.h], pos[s][j][1]);
+            const svg::Point q = ax.at(pos[s][j][v.h], pos[s][j][up]);
             n += inside(q);
             if (const int32_t par = k.joints[j].parent; par >= 0 && static_cast<uint32_t>(par) < j) {
-              const svg::Point pq = ax.at(pos[s][uint32_t(par)][v.h], pos[s][uint32_t(par)][1]);
+              const svg::Point pq = ax.at(pos[s][uint32_t(par)][v.h], pos[s][uint32_t(par)][up]);
               for (int t = 1; t < 8; ++t) n += inside({q.x + (pq.x - q.x) * t / 8, q.y + (pq.y - q.y) * t / 8});
             }
           }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "conventions.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/motion.h"
 
@@ -57,12 +58,12 @@ struct PoseFigure {
 };
 
 // Frame `frame` of one or two motions with the same skeleton (the caller checks both), front
-// view (x-y) and side view (z-y) at one scale with equal aspect ratio. Bones join every node to
-// its parent (End Sites included); joints are dots. With two series the worst node is circled
-// and labelled with its name and distance. `title` heads the figure. Poses by forward kinematics
-// under `reading` (keyanim/pose.h).
+// view and side view at one scale with equal aspect ratio, `up` upwards: x-y and z-y for y-up,
+// x-z and y-z for z-up. Bones join every node to its parent (End Sites included); joints are
+// dots. With two series the worst node is circled and labelled with its name and distance.
+// `title` heads the figure. Poses by forward kinematics under `reading` (keyanim/pose.h).
 PoseFigure render_pose(const std::vector<PoseSeries>& series, uint32_t frame, const std::string& title,
-                       PositionReading reading = PositionReading::replace);
+                       PositionReading reading = PositionReading::replace, UpAxis up = UpAxis::y);
 
 // True when the two skeletons have the same nodes (count, parents, End Site flags, names) and
 // channel layout, so that their poses can be compared node by node.

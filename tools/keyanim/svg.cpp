@@ -207,13 +207,34 @@ void Axes::draw(Document& doc, const std::string& x_label, const std::string& y_
 }
 
 namespace {
-// About 0.58 em per character of DejaVu Sans at 12 px; the gap separates entries.
-constexpr double kCharWidth = 7.0, kSampleWidth = 30.0, kEntryGap = 24.0;
+// The sample line's room before the label, and the gap that separates entries.
+constexpr double kSampleWidth = 30.0, kEntryGap = 24.0;
+
+// Characters of UTF-8 text: every byte that does not continue a sequence.
+size_t characters(std::string_view text) {
+  return static_cast<size_t>(std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
 }  // namespace
+
+double text_width(std::string_view text, double font_size, bool bold) {
+  // What is written: printable() turns control characters and bad bytes into \xHH.
+  return static_cast<double>(characters(cli::printable(text))) * font_size * (bold ? 0.68 : 0.62);
+}
+
+std::string elide_middle(std::string_view text, size_t max_chars) {
+  const std::string safe = cli::printable(text);
+  if (characters(safe) <= max_chars || max_chars < 3) return safe;
+  // Byte offsets of the characters' starts, so that no UTF-8 sequence is split.
+  std::vector<size_t> starts;
+  for (size_t i = 0; i < safe.size(); ++i)
+    if ((static_cast<unsigned char>(safe[i]) & 0xC0) != 0x80) starts.push_back(i);
+  const size_t keep = max_chars - 1, head = keep / 2, tail = keep - head;
+  return safe.substr(0, starts[head]) + "\xE2\x80\xA6" + safe.substr(starts[starts.size() - tail]);
+}
 
 double legend_width(const std::vector<LegendEntry>& entries) {
   double w = 0.0;
-  for (const LegendEntry& e : entries) w += kSampleWidth + kCharWidth * static_cast<double>(e.label.size()) + kEntryGap;
+  for (const LegendEntry& e : entries) w += kSampleWidth + text_width(e.label) + kEntryGap;
   return entries.empty() ? 0.0 : w - kEntryGap;
 }
 
@@ -225,7 +246,7 @@ void legend(Document& doc, Point at, const std::vector<LegendEntry>& entries) {
     doc.line(a, b, attr("stroke", e.colour) + attr("stroke-width", number(e.stroke_width)));
     if (e.marker) doc.circle({x + 12.0, at.y - 4.0}, 3.0, attr("fill", e.colour));
     doc.text({x + kSampleWidth, at.y}, e.label, "");
-    x += kSampleWidth + kCharWidth * static_cast<double>(e.label.size()) + kEntryGap;
+    x += kSampleWidth + text_width(e.label) + kEntryGap;
   }
   doc.close_group();
 }

@@ -99,7 +99,14 @@ struct LegendEntry {
   bool marker = false;   // also a dot on the sample line
   double stroke_width = 2.0;
 };
-// Estimated width of a legend row (text widths are guessed: no font metrics here).
+// Estimated width of `text` at `font_size` px: there are no font metrics here, so 0.62 em per
+// character (0.68 bold), more than DejaVu Sans's average, so that a layout that reserves this
+// much room does not clip (tools/tests/svg_bounds_test.cpp checks the figures with it).
+double text_width(std::string_view text, double font_size = 12.0, bool bold = false);
+// `text` cut to at most `max_chars` characters by an ellipsis in its middle: a file name keeps
+// its start and its end (".bvh").
+std::string elide_middle(std::string_view text, size_t max_chars);
+// Estimated width of a legend row (text_width at the document's 12 px).
 double legend_width(const std::vector<LegendEntry>& entries);
 // One row of entries starting at (x, y) (y: text baseline), left to right; class "legend".
 void legend(Document& doc, Point at, const std::vector<LegendEntry>& entries);

@@ -1,7 +1,9 @@
 // The rate-distortion figure: log axes (equal decades, plain tick labels, units in the axis
-// labels), a path and one circle per point for each series, unplottable points left out.
+// labels) fitted to the points, a path and one circle per point for each series, unplottable
+// points left out.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <string>
@@ -53,10 +55,38 @@ TEST_CASE("rd plot: equal decades on both log axes, points in order, one line pe
   CHECK(pts[3].first - pts[0].first == doctest::Approx(std::log10(5.0) * dx1).epsilon(0.01));
   CHECK(svg.find(">0.01<") != std::string::npos);
   CHECK(svg.find(">0.1<") != std::string::npos);
-  CHECK(svg.find(">1000<") != std::string::npos);
+  CHECK(svg.find(">500<") != std::string::npos);
+  CHECK(svg.find(">1000<") == std::string::npos);  // the axis ends a little above 500
   CHECK(svg.find("max error (% of the skeleton size, log scale)") != std::string::npos);
   CHECK(svg.find("compression ratio (raw float32 / .kanim bytes, log scale)") != std::string::npos);
   CHECK(svg.find(">2 files<") != std::string::npos);
+}
+
+// Issue 28, item 15: whole decades put eval's usual points (0.05% and 0.5%, ratios 9 to 38) in
+// a corner of 0.01..1 x 1..100. Fitted, they span the plot area but for its margins, and there
+// are ticks inside (1, 2, 5 times powers of ten, labelled).
+TEST_CASE("rd plot: the axes fit the data") {
+  const std::vector<RdSeries> series{{"a", {{0.0497, 10.78}, {0.497, 31.71}}},
+                                     {"b", {{0.0499, 9.21}, {0.5, 24.33}}},
+                                     {"c", {{0.0462, 16.17}, {0.463, 38.31}}}};
+  const std::string svg = rd_plot(series, "3 files");
+  const auto pts = circles(svg);
+  REQUIRE(pts.size() == 6);
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  for (const auto& [x, y] : pts) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  // The plot area: 600 x 400 px from (96, 76).
+  CHECK(x0 >= 96);
+  CHECK(x1 <= 696);
+  CHECK(y0 >= 76);
+  CHECK(y1 <= 476);
+  CHECK(x1 - x0 >= 0.85 * 600);
+  CHECK(y1 - y0 >= 0.85 * 400);
+  for (const char* tick : {">0.05<", ">0.1<", ">0.2<", ">0.5<", ">10<", ">20<"}) CHECK_MESSAGE(svg.find(tick) != std::string::npos, tick);
+  // One point: half a decade around it, with at least three ticks.
+  const std::string one = rd_plot({{"one", {{0.3, 12.0}}}}, "1 file");
+  CHECK(count(one, "class=\"tick-labels\"") == 1);
+  const size_t from = one.find("class=\"tick-labels\""), to = one.find("</g>", from);
+  CHECK(count(one.substr(from, to - from), "<text") >= 6);  // three on each axis
 }
 
 TEST_CASE("rd plot: an empty or unplottable input still makes a valid document") {

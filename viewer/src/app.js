@@ -1,13 +1,17 @@
 // The page: opening files (picker, drag and drop, embedded by `keyanim view`), playback, and
-// the panels. Decoding is the keyanim-three package's (packages/keyanim-three/src/decoder/);
-// drawing is view3d.js and curves.js.
+// the panels. A .kanim is shown decoded, with its original BVH overlaid when one is opened; a
+// BVH opened alone is played by itself (its frames, nearest frame between them). Decoding is
+// the keyanim-three package's (packages/keyanim-three/src/decoder/); drawing is view3d.js and
+// curves.js; what the camera follows and frames, framing.js; the up axis, upaxis.js.
 import { decodeKanim, looksLikeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
 import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { parseBvh } from './bvh.js';
 import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from 'keyanim-three/decoder/pose.js';
 import { View3D } from './view3d.js';
 import { CurvePanel } from './curves.js';
-import { clipFacts, noteLines } from './facts.js';
+import { clipFacts, bvhFacts, noteLines } from './facts.js';
+import { clipExtent, followedPoint } from './framing.js';
+import { detectUpAxis, toYUp } from './upaxis.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -29,7 +33,6 @@ export class App {
       this.clip = clip;
       this.clipName = name;
       this.values = new Float32Array(clip.channelCount);
-      this.size = skeletonSize(clip.nodes) || 1;
       if (this.original && !this.matches(this.original)) this.dropOriginal(`${this.originalName} does not have the skeleton of ${name}: not shown`);
       this.setup();
       this.message(`${name}: ${clip.frameCount} frames, ${clip.keyCount} keys`);
@@ -45,10 +48,12 @@ export class App {
       original.name = name;
       original.bytes = new TextEncoder().encode(text).length;
       if (this.clip && !this.matches(original)) throw new Error(`its skeleton differs from the clip's (${original.nodes.length} nodes, ${original.channelCount} channels; the clip: ${this.clip.nodes.length}, ${this.clip.channelCount})`);
+      if (original.frameCount === 0) throw new Error('the file has no frames');
       this.original = original;
       this.originalName = name;
-      if (this.clip) this.setup();
-      this.message(`${name}: ${original.frameCount} frames${original.warnings.length ? ` (${original.warnings.join('; ')})` : ''}`);
+      this.setup();
+      const alone = this.clip ? '' : '; playing the BVH alone: open its .kanim too to compare the two';
+      this.message(`${name}: ${original.frameCount} frames${original.warnings.length ? ` (${original.warnings.join('; ')})` : ''}${alone}`);
     } catch (e) {
       this.error(`${name}: ${e.message}`);
       throw e;
@@ -93,21 +98,44 @@ export class App {
 
   // --- Scene and panels --------------------------------------------------------------------
 
+  // What is shown: the clip, or the BVH when it is alone. Its nodes, frames and frame time.
+  get subject() { return this.clip ?? this.original; }
+
   setup() {
-    const clip = this.clip;
+    const clip = this.clip, s = this.subject;
     this.position = 0;
     this.clock = 0;
-    this.worstOverClip = this.original ? this.compareAllFrames() : null;
-    const first = worldPositions(clip.nodes, samplePose(clip, 0, this.values));
-    this.view.setSkeleton(clip.nodes, this.size, first, !!this.original);
+    this.size = skeletonSize(s.nodes) || 1;
+    this.detectedUp = detectUpAxis(s.nodes);
+    this.worstOverClip = clip && this.original ? this.compareAllFrames() : null;
+    this.frameView();
     this.curves.setClip(clip, this.original);
-    $('slider').max = String(clip.frameCount - 1);
-    $('facts').replaceChildren(...clipFacts(clip, this.original).flatMap(([k, v]) => [el('dt', k), el('dd', v)]));
-    $('notes').textContent = noteLines(clip).join('\n') || '(none)';
-    $('compare').hidden = !this.original;
+    $('slider').max = String(s.frameCount - 1);
+    $('facts').replaceChildren(...(clip ? clipFacts(clip, this.original) : bvhFacts(this.original)).flatMap(([k, v]) => [el('dt', k), el('dd', v)]));
+    $('notes').textContent = clip ? noteLines(clip).join('\n') || '(none)' : '(a BVH has none: open its .kanim)';
+    $('compare').hidden = !(clip && this.original);
+    $('show-original').disabled = !clip;
     document.body.classList.add('loaded');
     this.show(0);
   }
+
+  // The up axis shown: the control's, or the one detected from the rest pose (upaxis.js).
+  get up() { return $('up').value === 'auto' ? this.detectedUp.axis : $('up').value; }
+
+  // The figures and the camera for the subject: what the camera follows and frames comes from
+  // every source frame of the main figure (framing.js), in the viewer's y-up space.
+  frameView() {
+    const s = this.subject, auto = $('up').options[0];
+    auto.textContent = `auto (${this.detectedUp.axis}${this.detectedUp.ambiguous ? ', unclear' : ''})`;
+    this.extent = clipExtent(s.nodes, s.frameCount, (f) => this.mainAt(f), this.size);
+    this.view.setSkeleton(s.nodes, this.size, { decoded: !!this.clip, original: !!this.original }, this.extent, this.mainAt(this.position));
+  }
+
+  // World positions of the main figure (decoded, or the BVH alone) at frame position x, y-up.
+  mainAt(x) { return this.clip ? this.decodedAt(x) : this.originalAt(x); }
+
+  // The point the camera follows at frame position x (framing.js).
+  followedAt(x) { return followedPoint(this.mainAt(x), this.extent.placeholders); }
 
   // Largest distance between original and decoded over every source frame both have, on the
   // points the encoder's error covers (joints, End Sites, shell points; each reading it lists).
@@ -134,21 +162,23 @@ export class App {
     return worst;
   }
 
-  decodedAt(x) { return worldPositions(this.clip.nodes, samplePose(this.clip, x, this.values)); }
+  decodedAt(x) { return toYUp(worldPositions(this.clip.nodes, samplePose(this.clip, x, this.values)), this.up); }
 
   // The original at frame position x: its nearest frame (a BVH has nothing in between).
   originalAt(x) {
     const o = this.original, f = Math.min(o.frameCount - 1, Math.max(0, Math.round(x)));
-    return worldPositions(o.nodes, o.frames.subarray(f * o.channelCount, (f + 1) * o.channelCount));
+    return toYUp(worldPositions(o.nodes, o.frames.subarray(f * o.channelCount, (f + 1) * o.channelCount)), this.up);
   }
 
   // Draws frame position x everywhere.
   show(x) {
-    const clip = this.clip;
+    const clip = this.clip, s = this.subject;
     this.position = x;
-    const decoded = this.decodedAt(x);
+    const decoded = clip ? this.decodedAt(x) : null;
     let original = null, worst = null;
-    if (this.original) {
+    if (!clip) {
+      original = this.originalAt(x);
+    } else if (this.original) {
       // Compared at the nearest source frame: the original has nothing in between.
       const f = Math.min(Math.max(Math.round(x), 0), this.original.frameCount - 1);
       original = this.originalAt(f);
@@ -158,11 +188,12 @@ export class App {
       $('compare-frame').textContent = `${fmtLength(worst.distance)} at ${where(worst)} (${pct(worst.distance, this.size)} of the skeleton size${f === x ? '' : `; at frame ${f}, the nearest`})`;
       $('compare-clip').textContent = `${fmtLength(w.distance)} at ${where(w)}, frame ${w.frame} (${pct(w.distance, this.size)})`;
     }
-    this.view.setPoses(decoded, $('show-original').checked ? original : null, worst ? worst.node : -1);
-    this.view.showOriginal($('show-original').checked);
+    const withOriginal = !clip || $('show-original').checked;
+    this.view.setPoses(decoded, withOriginal ? original : null, worst ? worst.node : -1, followedPoint(decoded ?? original, this.extent.placeholders));
+    this.view.showOriginal(withOriginal);
     $('slider').value = String(x);
-    const t = clip.frameTime * x;
-    $('frame-label').textContent = `frame ${fmtFrame(x)} / ${clip.frameCount - 1} · ${t.toFixed(3)} s`;
+    const t = s.frameTime * x;
+    $('frame-label').textContent = `frame ${fmtFrame(x)} / ${s.frameCount - 1} · ${t.toFixed(3)} s`;
     this.curves.setPosition(x);
   }
 
@@ -171,17 +202,17 @@ export class App {
   // The frame position at clip time `seconds`: on the grid of the playback rate (source rate:
   // whole frames; 24/30/60/120 fps: in-betweens from the curves).
   positionAt(seconds) {
-    const clip = this.clip;
-    if (!(clip.frameTime > 0)) return 0;
-    const rate = $('rate').value === 'source' ? 1 / clip.frameTime : Number($('rate').value);
-    return Math.floor(seconds * rate + 1e-9) / rate / clip.frameTime;
+    const s = this.subject;
+    if (!(s.frameTime > 0)) return 0;
+    const rate = $('rate').value === 'source' ? 1 / s.frameTime : Number($('rate').value);
+    return Math.floor(seconds * rate + 1e-9) / rate / s.frameTime;
   }
 
   tick(now) {
     if (!this.playing) return;
     const dt = this.lastTick ? (now - this.lastTick) / 1000 : 0;
     this.lastTick = now;
-    const clip = this.clip, duration = (clip.frameCount - 1) * clip.frameTime;
+    const s = this.subject, duration = (s.frameCount - 1) * s.frameTime;
     this.clock += dt * Number($('speed').value);
     if (this.clock > duration) this.clock = duration > 0 ? this.clock % duration : 0;
     const x = this.positionAt(this.clock);
@@ -190,22 +221,28 @@ export class App {
   }
 
   setPlaying(on) {
-    this.playing = on && !!this.clip && this.clip.frameCount > 1;
+    this.playing = on && !!this.subject && this.subject.frameCount > 1;
     $('play').textContent = this.playing ? 'Pause' : 'Play';
     this.lastTick = 0;
     if (this.playing) requestAnimationFrame((t) => this.tick(t));
   }
 
   bindControls() {
+    this.view.follow = $('follow').checked;
     $('play').addEventListener('click', () => this.setPlaying(!this.playing));
     $('slider').addEventListener('input', () => {
-      if (!this.clip) return;
-      this.clock = Number($('slider').value) * this.clip.frameTime;
+      if (!this.subject) return;
+      this.clock = Number($('slider').value) * this.subject.frameTime;
       this.show(this.positionAt(this.clock));
     });
-    $('rate').addEventListener('change', () => this.clip && this.show(this.positionAt(this.clock)));
+    $('rate').addEventListener('change', () => this.subject && this.show(this.positionAt(this.clock)));
     $('show-original').addEventListener('change', () => this.clip && this.show(this.position));
-    $('follow').addEventListener('change', () => { this.view.follow = $('follow').checked; });
+    // Following on: the camera frames the body and moves with it; off: the whole clip's box.
+    $('follow').addEventListener('change', () => {
+      this.view.follow = $('follow').checked;
+      if (this.subject) { this.view.frame(this.extent, this.followedAt(this.position)); this.show(this.position); }
+    });
+    $('up').addEventListener('change', () => { if (this.subject) { this.frameView(); this.show(this.position); } });
     document.addEventListener('keydown', (e) => {
       if (e.target.tagName === 'SELECT' || e.target.tagName === 'INPUT' && e.target.type !== 'range') return;
       if (e.code === 'Space') { e.preventDefault(); this.setPlaying(!this.playing); }

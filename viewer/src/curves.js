@@ -1,5 +1,6 @@
 // The curve panel: one channel over time, the original (BVH) against the decoded curve, with
-// the keys marked and the playhead (what `keyanim plot` draws, live).
+// the keys marked and the playhead (what `keyanim plot` draws, live). With a BVH alone (clip
+// null), its curve only.
 import { channelValue } from 'keyanim-three/decoder/sample.js';
 import { CHANNEL_TYPES, nodeLabel } from 'keyanim-three/decoder/kanim.js';
 import { COLORS } from './view3d.js';
@@ -26,14 +27,18 @@ export class CurvePanel {
     this.clip = clip;
     this.original = original;
     this.originalCache = new Map();
-    const options = [];
-    clip.nodes.forEach((n, i) => n.channels.forEach((t, k) => options.push([n.firstChannel + k, `${nodeLabel(clip.nodes, i)} ${CHANNEL_TYPES[t]}`])));
-    this.channelSelect.replaceChildren(...options.map(([c, label]) => new Option(`${label} (${clip.channels[c].keyCount} keys)`, c)));
-    // Start on the busiest rotation channel: the one with the most keys.
-    const busiest = options.map(([c]) => c).filter((c) => clip.channels[c].type >= 3).sort((a, b) => clip.channels[b].keyCount - clip.channels[a].keyCount)[0];
+    const nodes = (clip ?? original).nodes, options = [];
+    this.types = [];
+    nodes.forEach((n, i) => n.channels.forEach((t, k) => { options.push([n.firstChannel + k, `${nodeLabel(nodes, i)} ${CHANNEL_TYPES[t]}`]); this.types[n.firstChannel + k] = t; }));
+    const keys = (c) => (clip ? clip.channels[c].keyCount : 0);
+    this.channelSelect.replaceChildren(...options.map(([c, label]) => new Option(clip ? `${label} (${keys(c)} keys)` : label, c)));
+    // Start on the busiest rotation channel: the one with the most keys (the first one, alone).
+    const busiest = options.map(([c]) => c).filter((c) => this.types[c] >= 3).sort((a, b) => keys(b) - keys(a))[0];
     if (busiest !== undefined) this.channelSelect.value = String(busiest);
     this.draw();
   }
+
+  get frameCount() { return (this.clip ?? this.original)?.frameCount ?? 0; }
 
   setPosition(position) { this.position = position; this.draw(); }
 
@@ -41,7 +46,7 @@ export class CurvePanel {
     if (!this.originalCache.has(c)) {
       const o = this.original, n = o.channelCount;
       const v = Array.from({ length: o.frameCount }, (_, f) => o.frames[f * n + c]);
-      this.originalCache.set(c, this.clip.channels[c].type >= 3 ? unwrapDegrees(v) : Float64Array.from(v));
+      this.originalCache.set(c, this.types[c] >= 3 ? unwrapDegrees(v) : Float64Array.from(v));
     }
     return this.originalCache.get(c);
   }
@@ -54,13 +59,13 @@ export class CurvePanel {
     const g = canvas.getContext('2d');
     g.setTransform(ratio, 0, 0, ratio, 0, 0);
     g.clearRect(0, 0, w, h);
-    if (!clip || clip.frameCount === 0 || w < 50) return;
-    const c = Number(this.channelSelect.value), ch = clip.channels[c];
+    if (this.frameCount === 0 || w < 50 || this.channelSelect.value === '') return;
+    const c = Number(this.channelSelect.value), ch = clip ? clip.channels[c] : null;
     const [a, b] = this.span();
     const decoded = [];
-    for (let x = 0; x <= w - 60; ++x) decoded.push(channelValue(ch, clip.tangentRule, Math.fround(a + ((b - a) * x) / (w - 60))));
+    if (ch) for (let x = 0; x <= w - 60; ++x) decoded.push(channelValue(ch, clip.tangentRule, Math.fround(a + ((b - a) * x) / (w - 60))));
     const orig = this.original ? this.originalValues(c) : null;
-    const keys = [...ch.keyFrames].map((k, i) => [k, ch.values[i]]).filter(([k]) => k >= a && k <= b);
+    const keys = ch ? [...ch.keyFrames].map((k, i) => [k, ch.values[i]]).filter(([k]) => k >= a && k <= b) : [];
     const shown = [...decoded, ...keys.map(([, v]) => v)];
     if (orig) for (let f = Math.max(0, Math.floor(a)); f <= Math.min(orig.length - 1, b); ++f) shown.push(orig[f]);
     let lo = Infinity, hi = -Infinity;
@@ -94,7 +99,7 @@ export class CurvePanel {
 
   // Frames shown: the whole clip, or a window around the playhead.
   span() {
-    const last = Math.max(1, this.clip.frameCount - 1), span = this.spanSelect.value;
+    const last = Math.max(1, this.frameCount - 1), span = this.spanSelect.value;
     if (span === 'all' || Number(span) >= last) return [0, last];
     const half = Number(span) / 2;
     const a = Math.min(Math.max(0, this.position - half), last - 2 * half);

@@ -24,3 +24,19 @@ export function clipFacts(clip, original) {
 
 // Encoder notes: key=value lines (spec 4.6), informative only.
 export const noteLines = (clip) => clip.notes.split('\n').filter((l) => l.trim() !== '');
+
+// A BVH shown alone: what it holds, and how to get the .kanim that the viewer compares it with.
+// original: from bvh.js's parseBvh, with name and bytes.
+export function bvhFacts(original) {
+  const joints = original.nodes.filter((n) => !n.endSite).length;
+  return [
+    ['format', 'BVH (no .kanim loaded)'],
+    ['frames', `${original.frameCount}`],
+    ['fps', original.frameTime > 0 ? fmt(1 / original.frameTime, 5) : '-'],
+    ['duration', original.frameTime > 0 ? `${fmt(Math.max(0, original.frameCount - 1) * original.frameTime, 4)} s` : '-'],
+    ['joints', `${joints} (+${original.nodes.length - joints} End Sites)`],
+    ['channels', `${original.channelCount}`],
+    ['bytes', bytes(original.bytes)],
+    ['to compare', `keyanim encode ${original.name} -o ${original.name.replace(/\.bvh$/i, '')}.kanim, then open both`],
+  ];
+}

@@ -9,18 +9,26 @@ app.loadEmbedded();
 
 // For tests and scripts: load(arrayBuffer) opens a .kanim (throws on a bad file),
 // loadOriginal(text) a BVH; sampleWorld(x) gives every node's world position [x, y, z] at
-// frame position x, in node order (the order of `keyanim sample --world --json`).
+// frame position x, in node order (the order of `keyanim sample --world --json`); frameCount and
+// nodeNames are the clip's, or the BVH's when it is shown alone; inView(x) shows frame position
+// x and gives, per node of the figure shown, its normalized device coordinates through the
+// page's camera and whether it is a placeholder (framing.js).
 window.keyanim = {
   load(buffer, name = 'clip.kanim') { app.loadClip(new Uint8Array(buffer), name); },
   loadOriginal(text, name = 'original.bvh') { app.loadOriginal(text, name); },
-  get frameCount() { return app.clip ? app.clip.frameCount : 0; },
-  get nodeNames() { return app.clip ? app.clip.nodes.map((n) => n.name) : []; },
+  get frameCount() { return app.subject ? app.subject.frameCount : 0; },
+  get nodeNames() { return app.subject ? app.subject.nodes.map((n) => n.name) : []; },
   sampleWorld(x) {
     if (!app.clip) throw new Error('no clip loaded');
     const p = worldPositions(app.clip.nodes, samplePose(app.clip, x));
     return Array.from({ length: app.clip.nodes.length }, (_, i) => [p[3 * i], p[3 * i + 1], p[3 * i + 2]]);
   },
   show(x) { app.show(x); },
+  inView(x) {
+    app.show(x);
+    return app.view.project(app.mainAt(x)).map((ndc, i) => ({ ndc, placeholder: app.extent.placeholders[i] === 1 }));
+  },
+  get up() { return app.subject ? app.up : null; },
   get comparison() { return app.original ? { ...app.worstOverClip } : null; },
   app,
 };

@@ -2,17 +2,20 @@
 // camera, and a ground grid scaled to the skeleton.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { fitCamera, followedPoint as followedPointOf } from './framing.js';
 
 export const COLORS = { decoded: 0xf08c28, original: 0x3aa0ff, worst: 0xff3050 };
 
 // One drawn skeleton: an instanced sphere per node and an instanced cylinder per bone
-// (node -> parent), both of radius proportional to the skeleton size.
+// (node -> parent), both of radius proportional to the skeleton size. No bone hangs from a
+// placeholder (framing.js): Bandai's joint_Root -> Hips would be a stick from the origin to
+// wherever the walker is.
 class SkeletonFigure {
   // onTop: drawn over everything else (the original, so that it shows through the decoded figure).
-  constructor(scene, nodes, color, radius, onTop = false) {
+  constructor(scene, nodes, color, radius, placeholders, onTop = false) {
     this.nodes = nodes;
     this.radius = radius;
-    this.bones = nodes.map((n, i) => [i, n.parent]).filter(([, p]) => p >= 0);
+    this.bones = nodes.map((n, i) => [i, n.parent]).filter(([, p]) => p >= 0 && !placeholders[p]);
     const material = new THREE.MeshLambertMaterial({ color, depthTest: !onTop });
     this.joints = new THREE.InstancedMesh(new THREE.SphereGeometry(radius, 12, 8), material, nodes.length);
     const cylinder = new THREE.CylinderGeometry(1, 1, 1, 8).translate(0, 0.5, 0);  // spans y 0..1
@@ -77,52 +80,77 @@ export class View3D {
     this.render();
   }
 
-  // A new skeleton of length scale `size`: the grid, the camera and the joint size follow it.
-  setSkeleton(nodes, size, firstPose, withOriginal) {
+  // A new skeleton of length scale `size` (the joint size follows it); `shown` says which
+  // figures there are ({ decoded, original }); `extent` is framing.js's clipExtent, on which the
+  // grid and the camera are set; firstPose, the main figure's positions now.
+  setSkeleton(nodes, size, shown, extent, firstPose) {
     for (const f of Object.values(this.figures)) f.dispose(this.scene);
     if (this.grid) { this.scene.remove(this.grid); this.grid.geometry.dispose(); }
-    const radius = size * 0.012;
-    // The original thinner and on top: where the two agree it shows as a blue core.
-    this.figures = { decoded: new SkeletonFigure(this.scene, nodes, COLORS.decoded, radius) };
-    if (withOriginal) this.figures.original = new SkeletonFigure(this.scene, nodes, COLORS.original, radius * 0.45, true);
+    const radius = size * 0.012, ph = extent.placeholders;
+    // With a clip, the original thinner and on top: where the two agree it shows as a blue core.
+    this.figures = {};
+    if (shown.decoded) this.figures.decoded = new SkeletonFigure(this.scene, nodes, COLORS.decoded, radius, ph);
+    if (shown.original) this.figures.original = shown.decoded ? new SkeletonFigure(this.scene, nodes, COLORS.original, radius * 0.45, ph, true)
+      : new SkeletonFigure(this.scene, nodes, COLORS.original, radius, ph);
     this.worst = this.worst ?? new THREE.Mesh(new THREE.SphereGeometry(1, 16, 12), new THREE.MeshBasicMaterial({ color: COLORS.worst, wireframe: true }));
     this.worst.scale.setScalar(radius * 2.2);
     this.worst.visible = false;
     this.scene.add(this.worst);
 
-    const box = boundsOf(firstPose);
-    const center = box.getCenter(new THREE.Vector3());
-    this.grid = new THREE.GridHelper(size * 8, 32, 0x66707f, 0x3a404c);
-    this.grid.position.set(center.x, box.min.y, center.z);
+    // The floor: the lowest point over the clip, under the whole path.
+    const { min, max } = extent.world, span = Math.max(max[0] - min[0], max[2] - min[2]);
+    this.grid = new THREE.GridHelper(Math.max(size * 8, span * 1.25), 32, 0x66707f, 0x3a404c);
+    this.grid.position.set((min[0] + max[0]) / 2, min[1], (min[2] + max[2]) / 2);
     this.scene.add(this.grid);
-    this.camera.near = size / 200;
-    this.camera.far = size * 200;
-    this.camera.position.set(center.x + size * 0.8, center.y + size * 0.35, center.z + size * 1.5);
-    this.camera.updateProjectionMatrix();
-    this.controls.target.copy(center);
-    this.controls.update();
-    this.lastRoot = null;
+    this.size = size;
+    this.frame(extent, followedPointOf(firstPose, ph));
   }
 
-  // Moves the figures; with `follow`, the camera target keeps the root in view.
-  setPoses(decoded, original, worstNode) {
-    this.figures.decoded?.update(decoded);
+  // Sets the camera on the clip: following, on the box the body spans around the followed
+  // point (at `followed` now); otherwise on the box of every node over the clip. The view
+  // direction is kept (the user's orbit), or the default one the first time.
+  frame(extent, followed) {
+    const direction = this.framed ? this.camera.position.clone().sub(this.controls.target).toArray() : undefined;
+    const options = { aspect: this.camera.aspect, fovDegrees: this.camera.fov, direction, minRadius: this.size / 4 };
+    const fit = this.follow ? fitCamera(extent.body, { ...options, offset: followed }) : fitCamera(extent.world, options);
+    this.camera.near = Math.min(this.size / 200, fit.distance / 100);
+    this.camera.far = Math.max(this.size * 200, (fit.distance + fit.radius) * 4);
+    this.camera.position.fromArray(fit.position);
+    this.camera.updateProjectionMatrix();
+    this.controls.target.fromArray(fit.target);
+    this.controls.update();
+    this.framed = true;
+    this.lastFollowed = new THREE.Vector3().fromArray(followed);
+  }
+
+  // Normalized device coordinates of positions (x, y, z per point) through the camera: a point
+  // is in the picture when x and y are within [-1, 1] and z within [-1, 1]. For the tests.
+  project(positions) {
+    this.camera.updateMatrixWorld();
+    const out = [], v = new THREE.Vector3();
+    for (let i = 0; i < positions.length; i += 3) out.push(v.set(positions[i], positions[i + 1], positions[i + 2]).project(this.camera).toArray());
+    return out;
+  }
+
+  // Moves the figures (either may be null); with `follow`, the camera and its target move with
+  // the followed point ([x, y, z], framing.js), keeping the view as the user set it.
+  setPoses(decoded, original, worstNode, followed) {
+    if (decoded) this.figures.decoded?.update(decoded);
     if (original && this.figures.original) this.figures.original.update(original);
-    if (worstNode >= 0 && original) {
+    if (worstNode >= 0 && original && decoded) {
       this.worst.position.set(decoded[3 * worstNode], decoded[3 * worstNode + 1], decoded[3 * worstNode + 2]);
       this.worst.visible = true;
     } else if (this.worst) {
       this.worst.visible = false;
     }
-    // Following: camera and target move with the root (node 0), keeping the view as set.
-    const root = new THREE.Vector3(decoded[0], decoded[1], decoded[2]);
-    if (this.follow && this.lastRoot) {
-      const shift = root.clone().sub(this.lastRoot);
+    const point = new THREE.Vector3().fromArray(followed);
+    if (this.follow && this.lastFollowed) {
+      const shift = point.clone().sub(this.lastFollowed);
       this.controls.target.add(shift);
       this.camera.position.add(shift);
       this.controls.update();
     }
-    this.lastRoot = root;
+    this.lastFollowed = point;
     this.render();
   }
 
@@ -130,8 +158,4 @@ export class View3D {
   render() { this.renderer.render(this.scene, this.camera); }
 }
 
-function boundsOf(p) {
-  const box = new THREE.Box3();
-  for (let i = 0; i < p.length; i += 3) box.expandByPoint(new THREE.Vector3(p[i], p[i + 1], p[i + 2]));
-  return box;
-}
+

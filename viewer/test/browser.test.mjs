@@ -2,6 +2,8 @@
 // loads a corpus clip with no console error; sampleWorld agrees with `keyanim sample --world
 // --json` within 1e-4 of the skeleton size, at frames and in-betweens; a screenshot of the 3D
 // view shows both skeletons (pixels of each colour). The same for a page from `keyanim view`.
+// A BVH opened alone plays; a Bandai-like walker stays in the picture (through the page's own
+// camera); a z-up file is shown upright.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -12,6 +14,7 @@ import { pathToFileURL } from 'node:url';
 import { decodeKanim } from 'keyanim-three/decoder/kanim.js';
 import { skeletonSize } from 'keyanim-three/decoder/pose.js';
 import { decodePng } from './png.mjs';
+import { bandaiLikeBvh } from './bandai-like.mjs';
 import { corpusDir, keyanimCli, viewerPage, sourceDir, exists } from './paths.mjs';
 
 const chromium = process.env.KEYANIM_CHROMIUM || '/usr/bin/chromium';
@@ -65,13 +68,15 @@ const isBackground = (r, g, b) => r === 0x1c && g === 0x1f && b === 0x26;
 const isOrange = (r, g, b) => r > g + 25 && g > b + 15 && r > 90;
 const isBlue = (r, g, b) => b > r + 50 && b > g + 10;
 
-async function expectSkeletonsDrawn(page, withOriginal, shotPath) {
+// withDecoded false: a BVH shown alone, drawn in the original's colour and nothing orange.
+async function expectSkeletonsDrawn(page, withOriginal, shotPath, withDecoded = true) {
   const view = await page.$('#view');
   const png = decodePng(Buffer.from(await view.screenshot(shotPath ? { path: shotPath } : {})));
   const pixels = png.width * png.height, background = count(png, isBackground);
   assert.ok(background > pixels * 0.3 && background < pixels * 0.995, `background ${background} of ${pixels} pixels: the view is blank or not drawn`);
   const orange = count(png, isOrange), blue = count(png, isBlue);
-  assert.ok(orange > 300, `${orange} orange pixels: no decoded skeleton in the screenshot`);
+  if (withDecoded) assert.ok(orange > 300, `${orange} orange pixels: no decoded skeleton in the screenshot`);
+  else assert.ok(orange < 20, `${orange} orange pixels without a clip`);
   if (withOriginal) assert.ok(blue > 100, `${blue} blue pixels: no original skeleton in the screenshot`);
   else assert.ok(blue < 20, `${blue} blue pixels without an original`);
 }
@@ -142,6 +147,78 @@ test('the file picker opens a clip and its original; a damaged file is reported 
   await page.waitForFunction(() => document.getElementById('message').className === 'error');
   assert.match(await page.$eval('#message', (e) => e.textContent), /^damaged\.kanim: checksum, offset \d+ \(0x[0-9a-f]+\): checksum_mismatch: /);
   assert.equal(await page.evaluate(() => window.keyanim.frameCount), clip.frameCount, 'the clip shown before stays');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+// Issue 28, items 10 and 2: a BVH opened alone is played (not "No clip loaded"), and the camera
+// keeps a Bandai-like walker (a ROOT that stays at the origin, Hips walking 800 units) in the
+// picture at every frame, following it or framing the whole clip; the clip's .kanim opened
+// next is compared with it.
+test('a BVH alone plays; a Bandai-like walker stays in the picture; its .kanim then compares', { skip }, async () => {
+  const bvhPath = path.join(dir, 'bandai_like.bvh'), kanimPath = path.join(dir, 'bandai_like.kanim');
+  fs.writeFileSync(bvhPath, bandaiLikeBvh());
+  cli('encode', bvhPath, '-o', kanimPath, '-q');
+  const { page, problems } = await open(pathToFileURL(viewerPage).href);
+  const input = await page.$('#open');
+  await input.uploadFile(bvhPath);
+  await page.waitForFunction(() => document.body.classList.contains('loaded'), { timeout: 10000 });
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), 195);
+  assert.match(await page.$eval('#message', (e) => e.textContent), /^bandai_like\.bvh: 195 frames; playing the BVH alone: open its \.kanim too to compare/);
+  assert.match(await page.$eval('#facts', (e) => e.textContent), /formatBVH \(no \.kanim loaded\)frames195/);
+  assert.equal(await page.$eval('#empty', (e) => getComputedStyle(e).display), 'none', '"No clip loaded" is hidden');
+  await expectSkeletonsDrawn(page, true, undefined, false);
+  // No bone from the placeholder joint_Root to Hips: 17 nodes, 16 links, 15 drawn.
+  assert.deepEqual(await page.evaluate(() => [window.keyanim.nodeNames.length, window.keyanim.app.view.figures.original.bones.length]), [17, 15]);
+
+  // In the picture at every tenth frame: following (the default: placeholders may leave), then
+  // with following off (every node, joint_Root too).
+  const expectInView = async (label, withPlaceholders) => {
+    for (let x = 0; x < 195; x += 10) {
+      const nodes = await page.evaluate((p) => window.keyanim.inView(p), x);
+      const lost = nodes.filter((n) => (withPlaceholders || !n.placeholder) && !n.ndc.every((v) => Math.abs(v) <= 1));
+      assert.deepEqual(lost, [], `${label}, frame ${x}`);
+    }
+  };
+  await expectInView('following', false);
+  await page.click('#follow');
+  await expectInView('whole clip', true);
+  await page.click('#follow');
+
+  // Playing moves the slider.
+  const slider = () => page.$eval('#slider', (e) => Number(e.value));
+  await page.evaluate(() => window.keyanim.show(0));
+  await page.click('#play');
+  await page.waitForFunction(() => Number(document.getElementById('slider').value) > 0, { timeout: 5000 });
+  await page.click('#play');
+  assert.ok(await slider() > 0);
+
+  // The .kanim opened next: decoded and compared with the BVH already open.
+  await input.uploadFile(kanimPath);
+  await page.waitForFunction(() => window.keyanim.comparison !== null, { timeout: 10000 });
+  await expectInView('the .kanim, following', false);
+  await expectSkeletonsDrawn(page, true);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+// Item 9: a z-up file is detected and shown upright: its joints span the screen's height.
+test('a z-up BVH is shown upright (up: auto detects z; y lays it down)', { skip }, async () => {
+  const zPath = path.join(dir, 'bandai_like_z.bvh');
+  fs.writeFileSync(zPath, bandaiLikeBvh('z'));
+  const { page, problems } = await open(pathToFileURL(viewerPage).href);
+  await page.evaluate((text) => window.keyanim.loadOriginal(text, 'bandai_like_z.bvh'), fs.readFileSync(zPath, 'utf8'));
+  assert.equal(await page.evaluate(() => window.keyanim.up), 'z');
+  assert.match(await page.$eval('#up', (e) => e.options[0].textContent), /^auto \(z\)$/);
+  // Upright: the head is above the feet on the screen (NDC y), by more than it is beside them.
+  const names = await page.evaluate(() => window.keyanim.nodeNames);
+  const head = names.indexOf('Head'), foot = names.indexOf('LeftLeg');
+  const rise = async () => { const n = await page.evaluate(() => window.keyanim.inView(0)); return n[head].ndc[1] - n[foot].ndc[1]; };
+  const upright = await rise();
+  assert.ok(upright > 0.2, `head ${upright} above the knee on screen with up z`);
+  await page.select('#up', 'y');
+  const lying = await rise();
+  assert.ok(Math.abs(lying) < upright / 3, `lying down with up y: ${lying} (upright: ${upright})`);
   assert.deepEqual(problems, []);
   await page.close();
 });
