@@ -95,8 +95,9 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
   }
   const internal::Curve& cv = img.curves[curve];
   if (curve >= img.block_curves) {  // a list curve
-    std::copy_n(img.list_frames.data() + cv.list_first, n, frames.data());
-    std::copy_n(img.list_values.data() + cv.list_first, n, values.data());
+    const internal::ListSpan list = img.lists[curve - img.block_curves];
+    std::copy_n(img.list_frames.data() + list.first, n, frames.data());
+    std::copy_n(img.list_values.data() + list.first, n, values.data());
     return Status::ok;
   }
   // Walk the records block by block: each lists its block's keys in its mask.

@@ -48,12 +48,17 @@ inline constexpr uint32_t kNoCurve = UINT32_MAX;
 inline constexpr uint32_t kPrefetchRecords = 8;  // see Image::record_offset
 inline constexpr size_t kPayloadPadding = 8;  // so that an 8-byte load at any record bit is in bounds
 
-// Per curve, what reading its records needs (the rest is in Image's per-curve arrays).
+// Per block curve, what reading its records needs (the rest is in Image's per-curve arrays):
+// 24 bytes, since a cold pose reads one per curve.
 struct Curve {
   int64_t q_base = 0;    // smallest q of the curve
   double step = 1.0;
   uint32_t base_bits = 0;  // wc
-  uint32_t list_first = 0, list_count = 0;  // a list curve's keys in Image::list_*
+};
+
+// A list curve's keys: Image::list_frames/list_values[first .. first + count).
+struct ListSpan {
+  uint32_t first = 0, count = 0;
 };
 
 struct Image {
@@ -84,6 +89,7 @@ struct Image {
   // linear in the keys whatever the frame count.
   std::vector<Curve> curves;
   uint32_t block_curves = 0;
+  std::vector<ListSpan> lists;           // list curve block_curves + i: lists[i]
   std::vector<uint32_t> list_frames;     // list curves' key frames, curve after curve
   std::vector<float> list_values;        // and their values
   std::vector<float> curve_s;            // (1 - tension) / 2

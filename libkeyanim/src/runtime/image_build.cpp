@@ -107,6 +107,7 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
 void shrink(Image& img) {
   img.fixed_channels.shrink_to_fit();
   img.curves.shrink_to_fit();
+  img.lists.shrink_to_fit();
   img.list_frames.shrink_to_fit();
   img.list_values.shrink_to_fit();
   for (auto* v : {&img.curve_s, &img.first_frame, &img.last_frame, &img.first_value, &img.last_value})
@@ -128,7 +129,8 @@ size_t Image::animation_bytes() const noexcept {
        last_frame.capacity() * sizeof(float) + first_value.capacity() * sizeof(float) +
        last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t) +
        curve_channel.capacity() * sizeof(uint32_t);
-  n += list_frames.capacity() * sizeof(uint32_t) + list_values.capacity() * sizeof(float);
+  n += lists.capacity() * sizeof(ListSpan) + list_frames.capacity() * sizeof(uint32_t) +
+       list_values.capacity() * sizeof(float);
   n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
   return n;
 }
@@ -182,8 +184,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
       cv.q_base = *lo;
       cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
       if (pass == 1) {
-        cv.list_first = static_cast<uint32_t>(img->list_frames.size());
-        cv.list_count = n;
+        img->lists.push_back({static_cast<uint32_t>(img->list_frames.size()), n});
         img->list_frames.insert(img->list_frames.end(), k, k + n);
         for (uint32_t i = 0; i < n; ++i) img->list_values.push_back(dequantize(q[i], sc.step));
       }

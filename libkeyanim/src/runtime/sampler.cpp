@@ -129,10 +129,10 @@ struct ListWindow {
   uint32_t j;  // index of key j in the list
 };
 
-void list_window(const Image& img, const Curve& cv, float f, ListWindow& w) noexcept {
-  const uint32_t* k = img.list_frames.data() + cv.list_first;
-  const float* v = img.list_values.data() + cv.list_first;
-  const uint32_t n = cv.list_count;
+void list_window(const Image& img, const ListSpan& list, float f, ListWindow& w) noexcept {
+  const uint32_t* k = img.list_frames.data() + list.first;
+  const float* v = img.list_values.data() + list.first;
+  const uint32_t n = list.count;
   const float clamped = std::min(std::max(f, static_cast<float>(k[0])), static_cast<float>(k[n - 1]));
   const uint32_t j = find_segment(k, n, clamped);
   w.j = j;
@@ -148,7 +148,7 @@ void list_window(const Image& img, const Curve& cv, float f, ListWindow& w) noex
 
 void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b, uint32_t i) noexcept {
   ListWindow w;
-  list_window(img, img.curves[curve], at.f, w);
+  list_window(img, img.lists[curve - img.block_curves], at.f, w);
   const int64_t start = int64_t(at.block) << kBlockShift;  // frames relative to f's block, as records
   for (int k = 0; k < 4; ++k) b.frames[i][k] = static_cast<int32_t>(w.frame[k] - start);
   std::memcpy(b.values[i], w.value, sizeof w.value);
@@ -335,12 +335,13 @@ void sample_range(const Image& img, float f, uint32_t first, uint32_t count, flo
 void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept {
   const Curve& cv = img.curves[curve];
   if (curve >= img.block_curves) {  // a list curve: the stream walks the list
+    const ListSpan list = img.lists[curve - img.block_curves];
     ListWindow w;
-    list_window(img, cv, f, w);
+    list_window(img, list, f, w);
     for (int i = 0; i < 4; ++i) s.k[i] = static_cast<int32_t>(w.frame[i]), s.v[i] = w.value[i];
-    s.list = img.list_frames.data() + cv.list_first;
-    s.list_values = img.list_values.data() + cv.list_first;
-    s.list_count = cv.list_count;
+    s.list = img.list_frames.data() + list.first;
+    s.list_values = img.list_values.data() + list.first;
+    s.list_count = list.count;
     s.list_next = w.j + 3;
     s.block = 0;
     return;
