@@ -176,6 +176,29 @@ KEYANIM_C_API keyanim_status keyanim_clip_load_file_limited(const char* path,
 /* Frees a clip (NULL: nothing). Cursors made for it keep its data until they are freed. */
 KEYANIM_C_API void keyanim_clip_free(keyanim_clip* clip);
 
+/* ---- Rigs: clips of one skeleton holding it once ------------------------------------------ */
+
+/* Clips of one rig (the same nodes, names, parents, offsets and channel lists) loaded through
+ * the same cache share one skeleton and its pose tables in memory: an engine holding many
+ * clips of one character holds its skeleton once (keyanim_clip_skeleton_bytes is then the
+ * shared part). Thread-safe; rigs are held weakly (a rig lives as long as a clip uses it), so
+ * the cache may be freed before or after its clips. */
+typedef struct keyanim_rig_cache keyanim_rig_cache;
+KEYANIM_C_API keyanim_status keyanim_rig_cache_create(keyanim_rig_cache** out);
+/* NULL: nothing. */
+KEYANIM_C_API void keyanim_rig_cache_free(keyanim_rig_cache* rigs);
+/* Rigs in use by at least one clip loaded through the cache (0 for NULL). */
+KEYANIM_C_API uint64_t keyanim_rig_cache_rig_count(const keyanim_rig_cache* rigs);
+/* keyanim_clip_load_limited (limits NULL: the defaults) through a rig cache (not NULL). */
+KEYANIM_C_API keyanim_status keyanim_clip_load_shared(const uint8_t* bytes, size_t size,
+                                                      const keyanim_decode_limits* limits,
+                                                      keyanim_rig_cache* rigs, keyanim_clip** out);
+/* 64-bit FNV-1a of the rig (each node's name, parent, offset bits, End Site flag and channel
+ * list, in node order): equal for clips of one skeleton (0 for NULL). */
+KEYANIM_C_API uint64_t keyanim_clip_rig_hash(const keyanim_clip* clip);
+/* 1 when both clips hold the very same skeleton in memory (loaded through one cache), else 0. */
+KEYANIM_C_API int32_t keyanim_clip_shares_rig(const keyanim_clip* a, const keyanim_clip* b);
+
 /* ---- What a clip holds (0 for a NULL clip) ---------------------------------------------------- */
 
 /* The format version of the file it was loaded from, (major << 16) | minor. */

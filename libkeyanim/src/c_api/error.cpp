@@ -44,7 +44,7 @@ void copy_text(char* to, size_t size, const char* from) {
   std::snprintf(to, size, "%s", from);
 }
 
-std::atomic<const void*> g_freed_clip{nullptr}, g_freed_cursor{nullptr};
+std::atomic<const void*> g_freed_clip{nullptr}, g_freed_cursor{nullptr}, g_freed_rigs{nullptr};
 
 }  // namespace
 
@@ -75,11 +75,15 @@ void forget_freed(const void* handle) noexcept {
   g_freed_clip.compare_exchange_strong(h, nullptr, std::memory_order_relaxed);
   h = handle;
   g_freed_cursor.compare_exchange_strong(h, nullptr, std::memory_order_relaxed);
+  h = handle;
+  g_freed_rigs.compare_exchange_strong(h, nullptr, std::memory_order_relaxed);
 }
 bool was_freed_clip(const void* handle) noexcept { return g_freed_clip.load(std::memory_order_relaxed) == handle; }
 bool was_freed_cursor(const void* handle) noexcept { return g_freed_cursor.load(std::memory_order_relaxed) == handle; }
 void note_freed_clip(const void* handle) noexcept { g_freed_clip.store(handle, std::memory_order_relaxed); }
 void note_freed_cursor(const void* handle) noexcept { g_freed_cursor.store(handle, std::memory_order_relaxed); }
+bool was_freed_rigs(const void* handle) noexcept { return g_freed_rigs.load(std::memory_order_relaxed) == handle; }
+void note_freed_rigs(const void* handle) noexcept { g_freed_rigs.store(handle, std::memory_order_relaxed); }
 
 }  // namespace keyanim::c_api
 

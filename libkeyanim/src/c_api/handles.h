@@ -16,6 +16,9 @@ struct keyanim_cursor {
   keyanim::Clip clip;
   keyanim::Cursor cursor;
 };
+struct keyanim_rig_cache {
+  keyanim::RigCache rigs;
+};
 // keyanim_skeleton is never defined: a pointer to one is a keyanim::Skeleton inside a clip.
 
 namespace keyanim::c_api {
@@ -30,7 +33,7 @@ keyanim_status fail(Status status, const char* function, const char* what, ...) 
 // Records a load's failure: the loader's section, offset and sentence.
 keyanim_status fail_load(const ErrorInfo& info) noexcept;
 
-// The most recently freed clip and cursor (any thread), so that freeing one twice, or using it
+// The most recently freed clip, cursor and rig cache (any thread), so that freeing one twice, or using it
 // right after, is refused rather than undefined. Cleared when the allocator hands the same
 // address to a new handle.
 void forget_freed(const void* handle) noexcept;
@@ -38,6 +41,8 @@ bool was_freed_clip(const void* handle) noexcept;
 bool was_freed_cursor(const void* handle) noexcept;
 void note_freed_clip(const void* handle) noexcept;
 void note_freed_cursor(const void* handle) noexcept;
+bool was_freed_rigs(const void* handle) noexcept;
+void note_freed_rigs(const void* handle) noexcept;
 
 // The handle's Clip, or null (with the last error recorded) for NULL or the last freed clip.
 inline const Clip* clip_of(const keyanim_clip* h, const char* function) noexcept {

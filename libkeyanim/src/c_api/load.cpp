@@ -75,6 +75,22 @@ keyanim_status keyanim_clip_load(const uint8_t* bytes, size_t size, keyanim_clip
   return keyanim_clip_load_limited(bytes, size, nullptr, out);
 }
 
+keyanim_status keyanim_clip_load_shared(const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
+                                        keyanim_rig_cache* rigs, keyanim_clip** out) {
+  const char* fn = "keyanim_clip_load_shared";
+  if ((bytes == nullptr && size != 0) || rigs == nullptr || was_freed_rigs(rigs)) {
+    if (out != nullptr) *out = nullptr;
+    if (rigs == nullptr) return fail(Status::invalid_argument, fn, "rigs is NULL");
+    if (was_freed_rigs(rigs)) return fail(Status::invalid_argument, fn, "rigs was freed");
+    return fail(Status::invalid_argument, fn, "bytes is NULL and size is %zu", size);
+  }
+  static const uint8_t kNone = 0;
+  const uint8_t* data = bytes != nullptr ? bytes : &kNone;
+  return load_into(fn, out, limits, [&](Clip& clip, ErrorInfo& info, const DecodeLimits& l) {
+    return Clip::load({data, size}, clip, &info, l, &rigs->rigs);
+  });
+}
+
 keyanim_status keyanim_clip_load_file_limited(const char* path, const keyanim_decode_limits* limits,
                                               keyanim_clip** out) {
   const char* fn = "keyanim_clip_load_file";
