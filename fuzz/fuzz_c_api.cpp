@@ -2,7 +2,8 @@
 // Input layout: fuzz_sample's (so that its seeds serve here too): byte 0 = number of requests n
 // (mod 33); then n records of 9 bytes (a mode byte and 8 bytes of payload); then the .kanim
 // file, whose CRC-32 is recomputed unless byte 0 is >= 231 (then the bytes load as given).
-// The bytes go through keyanim_clip_load_limited and through Clip::load with the same limits.
+// The bytes go through keyanim_clip_load_limited and through Clip::load with the same limits
+// (and, when they load, twice through one rig cache).
 // Checks: no crash; the same status; a failure leaves the handle NULL and its last error holds
 // the loader's section and offset; a loaded clip answers every question (counts, times,
 // memory, every node's name, parent, End Site flag, OFFSET, channels, rotation order) as Clip
@@ -173,6 +174,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   FUZZ_CHECK(h != nullptr);
   check_queries(h, clip);
+  // Through a rig cache: the same file twice shares one rig, hashed as the plain load's, and
+  // answers as Clip does.
+  keyanim_rig_cache* rigs = nullptr;
+  FUZZ_CHECK(keyanim_rig_cache_create(&rigs) == KEYANIM_OK);
+  keyanim_clip *s1 = nullptr, *s2 = nullptr;
+  FUZZ_CHECK(keyanim_clip_load_shared(file.data(), file.size(), &limits, rigs, &s1) == KEYANIM_OK);
+  FUZZ_CHECK(keyanim_clip_load_shared(file.data(), file.size(), &limits, rigs, &s2) == KEYANIM_OK);
+  FUZZ_CHECK(keyanim_clip_shares_rig(s1, s2) == 1 && keyanim_clip_rig_hash(s1) == clip.rig_hash());
+  keyanim_rig_cache_free(rigs);  // the clips keep their rig
+  check_queries(s2, clip);
+  keyanim_clip_free(s1);
+  keyanim_clip_free(s2);
   keyanim_cursor* cursor = nullptr;
   FUZZ_CHECK(keyanim_cursor_create(h, &cursor) == KEYANIM_OK);
   keyanim::Cursor cpp_cursor;
