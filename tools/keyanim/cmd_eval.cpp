@@ -15,6 +15,7 @@
 #include "eval_report.h"
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
@@ -193,8 +194,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
   for (const std::string& f : files)
     if (auto id = input_id(f)) ids.push_back(*id);
   std::optional<Output> svg, report;
-  if (auto path = args.get("--svg")) svg.emplace(*path, false, g, ids);
-  if (auto path = args.get("--report")) report.emplace(*path, false, g, ids);
+  if (auto path = args.get("--svg")) svg.emplace(*path, false, g, ids, svg_format(false, false));
+  if (auto path = args.get("--report")) report.emplace(*path, false, g, ids, json_lines_format());
   std::vector<nlohmann::json> results(files.size());
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);

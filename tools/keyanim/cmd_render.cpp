@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "figures.h"
 #include "keyanim/clip.h"
@@ -17,7 +18,7 @@
 namespace keyanim::cli {
 
 const char* const kRenderHelp =
-    "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg]\n"
+    "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg] [--to svg]\n"
     "                      [--position-channels replace|add] [--error E|E%] [--shell D|D%]\n"
     "                      [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
@@ -30,6 +31,8 @@ const char* const kRenderHelp =
     "  --against OTHER       a second file to compare with\n"
     "  -o, --output FILE     SVG output (default: IN without extension + -frameN.svg;\n"
     "                        '-' = standard output)\n"
+    "  --to svg              write the SVG under a name that does not end in .svg (without it,\n"
+    "                        a name that says another format, frame.png, is refused)\n"
     "  --position-channels replace|add\n"
     "                        how position channels below the root combine with OFFSET: replace\n"
     "                        it (Blender; default) or add to it (three.js)\n";
@@ -67,7 +70,7 @@ struct Poses {
 }  // namespace
 
 int cmd_render(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels"};
+  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels", "--to"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {});
   if (args.positional().size() != 1) fail(kUsage, "render takes one input file");
@@ -77,6 +80,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   if (against && *against == "-" && in == "-") fail(kUsage, "only one input can be standard input");
   const uint32_t frame_option = args.get_uint("--frame", 0);  // parsed before any work
   const PositionReading reading = position_reading(args);
+  const bool to_svg = stated_format(args, "svg");
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
@@ -91,7 +95,8 @@ int cmd_render(const Argv& argv, Globals& g) {
     fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(poses.frame_count() - 1) + ")");
   std::string out = args.get("-o").value_or("");
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, "") + "-frame" + std::to_string(frame) + ".svg";
-  Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}));
+  Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}),
+                svg_format(to_svg));
 
   const offline::Motion first = poses.one_frame(frame);
   offline::Motion second;

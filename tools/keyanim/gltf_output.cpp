@@ -1,12 +1,15 @@
 // keyanim decode to glTF (gltf_output.h).
 #include "gltf_output.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 
 #include "escape.h"
+#include "formats.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/gltf.h"
 #include "keyanim/offline/metrics.h"
@@ -17,8 +20,11 @@
 namespace keyanim::cli {
 namespace {
 
+// Ignoring ASCII case: WALK.GLB is a glTF name too.
 bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  if (s.size() < suffix.size()) return false;
+  return std::equal(suffix.begin(), suffix.end(), s.end() - std::ptrdiff_t(suffix.size()),
+                    [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b)); });
 }
 
 // A file name as a relative URI reference (RFC 3986): bytes other than unreserved ones are
@@ -67,9 +73,9 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
   std::optional<Output> bin;
   if (split) {
     o.bin_uri = uri_of_file_name(std::filesystem::path(bin_path).filename().string());
-    bin.emplace(bin_path, true, g, ids_of({&input}));
+    bin.emplace(bin_path, true, g, ids_of({&input}), gltf_buffer_format());
   }
-  Output main(out, !split, g, ids_of({&input}));
+  Output main(out, !split, g, ids_of({&input}), split ? gltf_json_format() : glb_format(args.has("--to")));
 
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
   if (args.has("--frames") && o.last_frame >= clip.frame_count())  // as the BVH output (cmd_decode.cpp)
