@@ -234,6 +234,34 @@ mismatch)
   expect_rc 0 "$K" verify w.kanim --against "$WALK"
   expect_rc 5 "$K" verify w.kanim --against "$WALK" --max-error 0.0001%
   ;;
+gltf_rate)
+  # glTF at another rate (issue 28, item 17): --fps keys are samples, not fitted; when the
+  # export is past the clip's tolerance a warning says by how much and why (keys 1/F s apart,
+  # between which the worst frame falls), and none is printed within it or with -q.
+  "$K" -q encode "$WALK" -o w.kanim || die "encode"
+  "$K" decode w.kanim -o w30.glb --fps 30 2>err || die "decode --fps 30"
+  python3 - <<'PY' || die "the warning: $(cat err)"
+import re
+text = open("err").read()
+m = re.search(r"error max ([0-9.e+-]+) \(.*, frame (\d+)\), tolerance ([0-9.e+-]+)", text)
+error, frame, tol = float(m[1]), int(m[2]), float(m[3])
+assert error > 10 * tol, (error, tol)
+w = re.search(r"keyanim: warning: w.kanim: with --fps 30 the export is [0-9.e+-]+ from the clip \(.*, frame (\d+)\), "
+              r"(\d+)x its tolerance .*keys 1/30 s apart.*source frames ([0-9.]+) and ([0-9.]+); the clip has a frame "
+              r"every .*120 fps\)\. The error is measured at every source frame", text)
+assert w, text
+assert int(w[1]) == frame and abs(int(w[2]) - error / tol) <= 1, (w.groups(), error / tol)
+a, b = float(w[3]), float(w[4])
+assert a <= frame <= b and b - a == 4, (a, b, frame)   # 120 fps / 30 fps: a key every 4 frames
+PY
+  "$K" -q decode w.kanim -o q30.glb --fps 30 2>err || die "decode -q --fps 30"
+  [ ! -s err ] || die "-q printed: $(cat err)"
+  for opts in "--fps 120" ""; do
+    # shellcheck disable=SC2086
+    "$K" decode w.kanim -o "x${opts// /}.glb" $opts 2>err || die "decode $opts"
+    grep -q warning err && die "a warning within the tolerance ($opts): $(cat err)"
+  done
+  ;;
 *) die "unknown case $CASE" ;;
 esac
 echo "ok: $CASE"
