@@ -84,8 +84,12 @@ int cmd_plot(const Argv& argv, Globals& g) {
   output.write(plot.svg);
   output.commit();
   if (g.verbosity > 0)
-    std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << plot.key_count << " keys shown of "
-              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "\n";
+    std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << count_of(plot.key_count, "key") << " shown of "
+              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "; alone, it moves a point by "
+              << plot.channel_world_error << " at most ("
+              << printable(plot.channel_world_point) << ", frame " << plot.channel_world_frame << "), "
+              << (plot.tolerance_units > 0 ? plot.channel_world_error / plot.tolerance_units : 0.0) << "x the "
+              << (settings.key_mode == offline::KeyMode::error ? "tolerance " : "--error ") << plot.tolerance_units << "\n";
   return kOk;
 }
 
