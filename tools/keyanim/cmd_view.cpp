@@ -133,21 +133,25 @@ int cmd_view(const Argv& argv, Globals& g) {
   std::optional<std::string> out = args.get("-o");
   const bool to_html = stated_format(args, "html");
   if (out && *out == "-") fail(kUsage, "view writes a file (its path is printed); use -o FILE.html");
-  if (out) check_output_name(*out, html_format(to_html));  // a usage error: before the page is looked for
-  const std::string page_template = read_page();  // before the work: a missing page is exit 3 at once
-
-  // Inputs and the output are opened and checked before anything is read.
+  // Inputs and a named output are opened and checked before anything is read (an input is
+  // never the output: exit 4; a name that says another format: exit 1), then the page is
+  // found (exit 3 at once if it is missing), and only then a temporary page made for it.
   Input clip_input(in, g);
   std::optional<Input> orig_input;
   if (auto orig = args.get("--against")) orig_input.emplace(*orig, g);
-  Globals write = g;
-  if (!out) {
-    out = temporary_page(in);
-    write.force = true;  // the empty file just made for it
-  }
   std::vector<const Input*> inputs = {&clip_input};
   if (orig_input) inputs.push_back(&*orig_input);
-  Output output(*out, false, write, ids_of(inputs), html_format(to_html));
+  std::optional<Output> named;
+  if (out) named.emplace(*out, false, g, ids_of(inputs), html_format(to_html));
+  const std::string page_template = read_page();
+  std::optional<Output> temporary;
+  if (!out) {
+    out = temporary_page(in);
+    Globals write = g;
+    write.force = true;  // the empty file just made for it
+    temporary.emplace(*out, false, write, ids_of(inputs), html_format(to_html));
+  }
+  Output& output = named ? *named : *temporary;
 
   const std::vector<uint8_t> clip_bytes = clip_input.read(Kind::kanim);
   const Clip clip = load_kanim(in, clip_bytes, g);  // the page decodes it again; a bad file fails here, clearly
