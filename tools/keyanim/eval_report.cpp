@@ -113,11 +113,56 @@ struct RunTotal {
   Numbers n;
 };
 
+// A result's figures as a row.
+Numbers row_numbers(const nlohmann::json& r) {
+  Numbers n;
+  n.keys = r["keys"].get<unsigned long long>();
+  n.bytes = r["kanim_bytes"].get<unsigned long long>();
+  n.raw = r["ratio_raw_f32"].get<double>(), n.bvh = r["ratio_bvh"].get<double>(), n.zstd = r["ratio_bvh_zstd19"].get<double>();
+  n.max_error = r["error"]["max"].get<double>(), n.rms = r["error"]["rms"].get<double>();
+  n.enc_ms = r["encode_ms"].get<double>(), n.dec_ms = r["decode_ms"].get<double>();
+  return n;
+}
+
+// Per run (key mode and setting), in the order first met: the sums over the files, then the
+// total row's figures from them.
+std::vector<RunTotal> run_totals(const std::vector<nlohmann::json>& files) {
+  std::vector<RunTotal> totals;
+  for (const auto& f : files) {
+    if (f.is_null()) continue;
+    for (const auto& r : f["results"]) {
+      const std::string mode = r.value("key_mode", "error"), setting = setting_of(r);
+      auto it = std::find_if(totals.begin(), totals.end(), [&](const RunTotal& t) { return t.mode == mode && t.setting == setting; });
+      if (it == totals.end()) it = totals.insert(totals.end(), RunTotal{mode, setting, 0, 0, 0, 0, 0, 0, Numbers{}});
+      RunTotal& t = *it;
+      const Numbers n = row_numbers(r);
+      ++t.files;
+      t.raw += f["raw_f32_bytes"].get<double>();
+      t.bvh += f["bvh_bytes"].get<double>();
+      t.zstd += f["bvh_zstd19_bytes"].get<double>();
+      const double samples = f["frames"].get<double>() * f.value("nodes", 0.0);  // what each RMS is over
+      t.squares += n.rms * n.rms * samples;
+      t.samples += samples;
+      t.n.keys += n.keys, t.n.bytes += n.bytes;
+      t.n.max_error = std::max(t.n.max_error, n.max_error);
+      t.n.enc_ms += n.enc_ms, t.n.dec_ms += n.dec_ms;
+    }
+  }
+  for (RunTotal& t : totals) {
+    const double bytes = double(t.n.bytes);
+    t.n.raw = bytes > 0 ? t.raw / bytes : 0.0, t.n.bvh = bytes > 0 ? t.bvh / bytes : 0.0;
+    t.n.zstd = bytes > 0 ? t.zstd / bytes : 0.0;
+    t.n.rms = t.samples > 0 ? std::sqrt(t.squares / t.samples) : 0.0;
+  }
+  return totals;
+}
+
 }  // namespace
 
 std::string eval_table(const std::vector<nlohmann::json>& files, bool acl) {
   std::vector<std::string> paths, modes;
   bool all_error_mode = true;
+  size_t mode_w = width("keys mode"), setting_w = 0;
   for (const auto& f : files) {
     if (f.is_null()) continue;
     paths.push_back(f["file"].get<std::string>());
@@ -125,41 +170,18 @@ std::string eval_table(const std::vector<nlohmann::json>& files, bool acl) {
       const std::string mode = r.value("key_mode", "error");
       if (std::find(modes.begin(), modes.end(), mode) == modes.end()) modes.push_back(mode);
       all_error_mode = all_error_mode && r.contains("tolerance");
+      mode_w = std::max(mode_w, width(printable(mode)));
+      setting_w = std::max(setting_w, width(printable(setting_of(r))));
     }
   }
   const std::string prefix = common_directory(paths);
   const std::string file_head = prefix.empty() ? "file" : "file, below " + printable(prefix);
   const std::string setting_head = all_error_mode ? "tolerance" : "--error";
-  const bool mode_column = modes.size() > 1;
-  size_t name_w = width(file_head), mode_w = width("keys mode"), setting_w = width(setting_head);
-  for (const std::string& p : paths) name_w = std::max(name_w, width(printable(p.substr(prefix.size()))));
-  std::vector<RunTotal> totals;
-  for (const auto& f : files) {
-    if (f.is_null()) continue;
-    for (const auto& r : f["results"]) {
-      const std::string mode = r.value("key_mode", "error"), setting = setting_of(r);
-      mode_w = std::max(mode_w, width(printable(mode)));
-      setting_w = std::max(setting_w, width(printable(setting)));
-      auto it = std::find_if(totals.begin(), totals.end(), [&](const RunTotal& t) { return t.mode == mode && t.setting == setting; });
-      if (it == totals.end()) it = totals.insert(totals.end(), RunTotal{mode, setting, 0, 0, 0, 0, 0, 0, Numbers{}});
-      RunTotal& t = *it;
-      ++t.files;
-      const double bytes = r["kanim_bytes"].get<double>();
-      t.raw += f["raw_f32_bytes"].get<double>();
-      t.bvh += f["bvh_bytes"].get<double>();
-      t.zstd += f["bvh_zstd19_bytes"].get<double>();
-      const double samples = f["frames"].get<double>() * f.value("nodes", 0.0);
-      t.squares += std::pow(r["error"]["rms"].get<double>(), 2) * samples;
-      t.samples += samples;
-      t.n.keys += r["keys"].get<unsigned long long>();
-      t.n.bytes += static_cast<unsigned long long>(bytes);
-      t.n.max_error = std::max(t.n.max_error, r["error"]["max"].get<double>());
-      t.n.enc_ms += r["encode_ms"].get<double>();
-      t.n.dec_ms += r["decode_ms"].get<double>();
-    }
-  }
   const std::string total_label = "total (" + std::to_string(paths.size()) + (paths.size() == 1 ? " file)" : " files)");
-  name_w = std::max(name_w, width(total_label));
+  const bool mode_column = modes.size() > 1, with_totals = paths.size() > 1;  // one file's total is its row again
+  size_t name_w = std::max(width(file_head), with_totals ? width(total_label) : 0);
+  for (const std::string& p : paths) name_w = std::max(name_w, width(printable(p.substr(prefix.size()))));
+  setting_w = std::max(setting_w, width(setting_head));
   auto lead = [&](const std::string& name, const std::string& mode, const std::string& setting) {
     return pad_right(name, name_w) + (mode_column ? " " + pad_right(mode, mode_w) : std::string()) + " " +
            pad_left(setting, setting_w);
@@ -171,25 +193,13 @@ std::string eval_table(const std::vector<nlohmann::json>& files, bool acl) {
   for (const auto& f : files) {
     if (f.is_null()) continue;
     const std::string name = printable(f["file"].get<std::string>().substr(prefix.size()));
-    for (const auto& r : f["results"]) {
-      Numbers n;
-      n.keys = r["keys"].get<unsigned long long>();
-      n.bytes = r["kanim_bytes"].get<unsigned long long>();
-      n.raw = r["ratio_raw_f32"].get<double>(), n.bvh = r["ratio_bvh"].get<double>(), n.zstd = r["ratio_bvh_zstd19"].get<double>();
-      n.max_error = r["error"]["max"].get<double>(), n.rms = r["error"]["rms"].get<double>();
-      n.enc_ms = r["encode_ms"].get<double>(), n.dec_ms = r["decode_ms"].get<double>();
-      out += lead(name, printable(r.value("key_mode", "error")), printable(setting_of(r))) + number_columns(n) +
+    for (const auto& r : f["results"])
+      out += lead(name, printable(r.value("key_mode", "error")), printable(setting_of(r))) + number_columns(row_numbers(r)) +
              (acl ? acl_columns(r) : "") + "\n";
-    }
   }
-  for (RunTotal& t : totals) {
-    if (paths.size() < 2) break;  // one file's total is its row again
-    const double bytes = double(t.n.bytes);
-    t.n.raw = bytes > 0 ? t.raw / bytes : 0.0, t.n.bvh = bytes > 0 ? t.bvh / bytes : 0.0;
-    t.n.zstd = bytes > 0 ? t.zstd / bytes : 0.0;
-    t.n.rms = t.samples > 0 ? std::sqrt(t.squares / t.samples) : 0.0;
-    out += lead(total_label, printable(t.mode), printable(t.setting)) + number_columns(t.n) + "\n";
-  }
+  if (with_totals)
+    for (const RunTotal& t : run_totals(files))
+      out += lead(total_label, printable(t.mode), printable(t.setting)) + number_columns(t.n) + "\n";
   return out;
 }
 
