@@ -8,7 +8,8 @@
 #     into a scratch prefix (KEYANIM_PREFIX: an installed keyanim is left alone), with that
 #     prefix's bin/ on PATH as the set-up asks;
 #  3. every session of the README (blocks of "$ " lines) pasted line by line, printing what the
-#     README shows (tests/newcomer/readme_session.py);
+#     README shows (tests/newcomer/readme_session.py), leaving nothing in the checkout (they
+#     write under the ignored scratch/); outputs named for another format (walk.fbx) refused;
 #  4. every command's --help read for options described twice and incomplete usage lines
 #     (tests/cli/help_test.py); `man keyanim`, the bash completion and `import keyanim` found;
 #  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
@@ -45,6 +46,22 @@ export PATH="$KEYANIM_PREFIX/bin:$PATH"
 
 step "3. the README's sessions, pasted line by line"
 "$PY" tests/newcomer/readme_session.py README.md
+# They write under scratch/, which git ignores: nothing is left in the checkout (issue 28, item 19).
+left=$(git status --porcelain --untracked-files=all)
+[ -z "$left" ] || { echo "newcomer: FAIL: the README's sessions left files in the checkout:"; echo "$left"; exit 1; }
+echo "the sessions left nothing in the checkout"
+# An output named for another format is refused, naming the file and the extension to use, and
+# nothing is written (issue 28, item 12): what a user who types walk.fbx or out.bvh gets.
+refused() {  # refused FILE EXT command...
+  local file=$1 ext=$2 rc=0; shift 2
+  "$@" 2>"$T/refused.err" || rc=$?
+  [ "$rc" -eq 1 ] && grep -q "$file: this writes .*name it $ext" "$T/refused.err" && [ ! -e "$file" ] ||
+    { echo "newcomer: FAIL: '$*' exited $rc (expected 1, naming $file and $ext): $(cat "$T/refused.err")"; exit 1; }
+}
+refused scratch/walk.fbx .bvh keyanim decode scratch/walk.kanim -o scratch/walk.fbx
+refused scratch/out.bvh .kanim keyanim encode data/cmu_02_01_walk.bvh -o scratch/out.bvh
+refused scratch/curve.png .svg keyanim plot data/cmu_02_01_walk.bvh --channel Hips:Xrotation -o scratch/curve.png
+echo "outputs named for another format are refused: $(head -n1 "$T/refused.err")"
 
 step "4. every command's help; man keyanim; bash completion; import keyanim"
 "$PY" tests/cli/help_test.py "$(command -v keyanim)"

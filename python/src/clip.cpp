@@ -1,6 +1,7 @@
 // keyanim.Clip: a .kanim loaded and sampled in bulk (the GIL released), its info, decoding back
 // to a Motion, and a clip made from a Motion's own frames.
 #include <cerrno>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -36,6 +37,16 @@ std::vector<uint8_t> buffer_bytes(const py::object& source) {
   return bytes;
 }
 
+// Blanks (and a UTF-8 byte order mark), then HIERARCHY in any case: what the BVH reader takes.
+bool starts_like_bvh(const std::vector<uint8_t>& b) {
+  size_t i = b.size() >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF ? 3 : 0;
+  while (i < b.size() && (b[i] == ' ' || (b[i] >= '\t' && b[i] <= '\r'))) ++i;
+  static const char word[] = "hierarchy";
+  for (size_t k = 0; k < 9; ++k, ++i)
+    if (i >= b.size() || std::tolower(b[i]) != word[k]) return false;
+  return true;
+}
+
 std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
   auto c = std::make_shared<PyClip>();
   std::vector<uint8_t> bytes;
@@ -49,18 +60,51 @@ std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
   py::gil_scoped_release unlocked;
   if (c->file) bytes = offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
   ErrorInfo info;
-  if (Clip::load(bytes, c->clip, &info, {}, rigs) != Status::ok) throw offline::Error::kanim(c->file.value_or(""), info);
+  if (Clip::load(bytes, c->clip, &info, {}, rigs) != Status::ok) {
+    // A BVH file given where a .kanim goes: say where it goes instead of "bad signature".
+    if (starts_like_bvh(bytes))
+      throw offline::Error(offline::ErrorKind::malformed,
+                           "is BVH text, not a .kanim: read it with keyanim.read_bvh(path), then keyanim.encode(motion) "
+                           "for a .kanim's bytes or keyanim.Clip.from_motion(motion) for a clip of its frames",
+                           c->file.value_or(""));
+    throw offline::Error::kanim(c->file.value_or(""), info);
+  }
   c->bytes = bytes.size();
   return c;
 }
 
-// Frame positions from times (seconds) or frames: exactly one of them.
+// A position the clip does not have is keyanim.Error naming it and the clip's range, as
+// `keyanim sample` refuses it (exit 1): positions are not clamped. A time may exceed the
+// duration by rounding (duration = (frames - 1) frame time).
+void check_positions(const PyClip& c, const Positions& p, const Positions* times) {
+  const uint32_t n = c.clip.frame_count();
+  const double last = n ? double(n - 1) : 0.0;
+  for (size_t i = 0; i < p.values.size(); ++i) {
+    const double pos = p.values[i];
+    if (n > 0 && pos >= 0.0 && (pos <= last || (times && pos <= last * (1.0 + 1e-12)))) continue;
+    char what[256];
+    if (n == 0) std::snprintf(what, sizeof what, "the clip has no frames to sample");
+    else if (times)
+      std::snprintf(what, sizeof what, "time %.9g s is not in the clip (it has %u frames, times 0 to %.9g s)",
+                    times->values[i], n, c.clip.duration());
+    else std::snprintf(what, sizeof what, "frame %.9g is not in the clip (it has %u frames, 0 to %u)", pos, n, n - 1);
+    throw offline::Error(offline::ErrorKind::invalid_argument, what, c.file.value_or(""));
+  }
+}
+
+// Frame positions from times (seconds) or frames: exactly one of them, each in the clip.
 Positions where(const PyClip& c, const py::handle& times, const py::handle& frames) {
   if (times.is_none() == frames.is_none()) throw py::type_error("give either times or frames (keyword), not both or neither");
-  if (!frames.is_none()) return positions_arg(frames, "frames");
-  Positions p = positions_arg(times, "times");
+  if (!frames.is_none()) {
+    Positions p = positions_arg(frames, "frames");
+    check_positions(c, p, nullptr);
+    return p;
+  }
+  const Positions given = positions_arg(times, "times");
+  Positions p = given;
   const double ft = c.clip.frame_time();
   for (double& t : p.values) t = ft > 0.0 ? t / ft : 0.0;  // as Clip::sample_time
+  check_positions(c, p, &given);
   return p;
 }
 
@@ -145,6 +189,8 @@ void register_clip(py::module_& m) {
       "degrees) as the encoder unwraps them.");
   cls.def_property_readonly("frame_count", [](const PyClip& c) { return c.clip.frame_count(); }, "Number of source frames.");
   cls.def_property_readonly("frame_time", [](const PyClip& c) { return c.clip.frame_time(); }, "Seconds between frames.");
+  cls.def_property_readonly("fps", [](const PyClip& c) { return fps_of(c.clip.frame_time()); },
+                            "Frames per second, 1 / frame_time (None without a frame time).");
   cls.def_property_readonly("duration", [](const PyClip& c) { return c.clip.duration(); },
                             "(frame_count - 1) * frame_time seconds, 0 without frames.");
   cls.def_property_readonly("channel_count", [](const PyClip& c) { return c.clip.channel_count(); }, "Values per frame.");
@@ -180,12 +226,14 @@ void register_clip(py::module_& m) {
       "sample", [](const PyClip& c, const py::object& times) { return sample(c, where(c, times, py::none())); },
       py::arg("times"),
       "Every channel at each time in seconds: float32 array times.shape + (channels,). Times\n"
-      "are clamped to the clip; between frames the values are in-betweens.");
+      "are 0 to duration (others raise keyanim.Error naming them, as `keyanim sample --time`\n"
+      "refuses them); between frames the values are in-betweens.");
   cls.def(
       "sample_frames", [](const PyClip& c, const py::object& frames) { return sample(c, where(c, py::none(), frames)); },
       py::arg("frames"),
       "Every channel at each frame position (fractional positions are in-betweens): float32\n"
-      "array frames.shape + (channels,).");
+      "array frames.shape + (channels,). Positions are 0 to frame_count - 1; others raise\n"
+      "keyanim.Error naming them (as in local_transforms and world_positions).");
   cls.def(
       "local_transforms",
       [](const PyClip& c, const py::object& times, const py::object& frames, const std::string& reading) {

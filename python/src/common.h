@@ -75,6 +75,14 @@ FrameList frames_arg(const py::handle& frames, uint32_t frame_count);
 template <class Class, class Get>
 void def_skeleton_properties(Class& cls, Get skeleton_of);
 
+// keyanim.read_bvh: a BVH file (str, bytes or os.PathLike) as a Motion, through the CLI's guards.
+PyMotion read_bvh_path(const py::object& path);
+
+// Motion.fps and Clip.fps: 1 / frame_time, None for a clip or motion without a frame time.
+inline py::object fps_of(double frame_time) {
+  return frame_time > 0.0 ? py::object(py::float_(1.0 / frame_time)) : py::object(py::none());
+}
+
 void register_errors(py::module_& m);
 void register_motion(py::module_& m);
 void register_encode(py::module_& m);

@@ -97,7 +97,7 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
   s.validate();
 }
 
-py::tuple encode(const PyMotion& m, const py::object& error, const py::object& keys, const py::kwargs& kwargs) {
+py::tuple encode_motion(const PyMotion& m, const py::object& error, const py::object& keys, const py::kwargs& kwargs) {
   offline::EncodeSettings settings;
   settings.threads = 0;  // as `keyanim encode` does for one file: one thread per core
   set_tolerance(error, settings);
@@ -121,12 +121,24 @@ py::tuple encode(const PyMotion& m, const py::object& error, const py::object& k
   return py::make_tuple(py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()), report);
 }
 
+// A Motion, or a path to a BVH file read as read_bvh reads it; anything else is a TypeError that
+// says what encode takes (pybind's own lists signatures only).
+py::tuple encode(const py::object& motion, const py::object& error, const py::object& keys, const py::kwargs& kwargs) {
+  if (py::isinstance<PyMotion>(motion)) return encode_motion(motion.cast<const PyMotion&>(), error, keys, kwargs);
+  const py::object fspath = py::module_::import("os").attr("PathLike");
+  if (py::isinstance<py::str>(motion) || py::isinstance<py::bytes>(motion) || py::isinstance(motion, fspath))
+    return encode_motion(read_bvh_path(motion), error, keys, kwargs);
+  throw py::type_error("encode() takes a keyanim.Motion (keyanim.read_bvh(path), Clip.to_motion()) or the path of a "
+                       "BVH file, not " + std::string(py::str(motion.get_type().attr("__name__"))));
+}
+
 }  // namespace
 
 void register_encode(py::module_& m) {
   m.def("encode", &encode, py::arg("motion"), py::arg("error") = "0.05%", py::arg("keys") = "error",
         "encode(motion, error='0.05%', keys='error', **settings) -> (bytes, report)\n\n"
-        "Encodes a Motion into a .kanim file's bytes, as `keyanim encode` does, and returns them\n"
+        "Encodes a Motion (or the BVH file at a path: str, bytes or os.PathLike, read as read_bvh\n"
+        "reads it) into a .kanim file's bytes, as `keyanim encode` does, and returns them\n"
         "with a report dict holding the same keys as `keyanim encode --json`: frames, channels,\n"
         "frame_time, keys, bvh_bytes, raw_f32_bytes, kanim_bytes, ratio_raw_f32, encode_ms,\n"
         "error: {max, rms, worst_joint, worst_point, worst_shell_axis, worst_frame, shell,\n"

@@ -23,7 +23,9 @@ namespace {
 
 // BVH text of `path` as a Motion; warnings (more motion lines than Frames: declares) are
 // Python warnings.
-PyMotion read(const py::object& path_arg) {
+}  // namespace
+
+PyMotion read_bvh_path(const py::object& path_arg) {
   PyMotion m;
   m.source = path_of(path_arg);
   std::vector<std::string> warnings;
@@ -40,6 +42,8 @@ PyMotion read(const py::object& path_arg) {
     if (PyErr_WarnEx(PyExc_UserWarning, std::string(py::str(text(w))).c_str(), 1) != 0) throw py::error_already_set();
   return m;
 }
+
+namespace {
 
 // Writes through a temporary file beside `path`, renamed over it once complete; an existing
 // file is replaced only with overwrite. A device, a FIFO or a link to one, or to a standard
@@ -128,6 +132,14 @@ void register_motion(py::module_& m) {
                             "Seconds between frames (frame i is at i * frame_time).");
   cls.def_property_readonly("channel_count", [](const PyMotion& self) { return self.motion.channel_count(); },
                             "Number of channels (values per frame).");
+  cls.def_property_readonly("fps", [](const PyMotion& self) { return fps_of(self.motion.frame_time); },
+                            "Frames per second, 1 / frame_time (None when frame_time is 0). BVH stores the\n"
+                            "frame time rounded: a CMU file's 0.0083333 gives 120.0005, not 120.");
+  cls.def_property_readonly(
+      "duration",
+      [](const PyMotion& self) { return self.motion.frame_count ? (self.motion.frame_count - 1) * self.motion.frame_time : 0.0; },
+      "(frame_count - 1) * frame_time seconds, the time of the last frame (0 without frames), as\n"
+      "Clip.duration.");
   cls.def_property_readonly(
       "source", [](const PyMotion& self) { return self.source ? py::object(text(*self.source)) : py::object(py::none()); },
       "The BVH file it was read from, or None.");
@@ -198,7 +210,7 @@ void register_motion(py::module_& m) {
            std::to_string(self.motion.channel_count()) + " channels>";
   });
 
-  m.def("read_bvh", &read, py::arg("path"),
+  m.def("read_bvh", &read_bvh_path, py::arg("path"),
         "Reads a BVH file into a Motion, exactly (every value bit for bit). Raises keyanim.Error\n"
         "with file, line and column for malformed text, OSError when the file cannot be read.\n"
         "Releases the GIL while reading.");

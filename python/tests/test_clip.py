@@ -86,9 +86,9 @@ def test_skeleton_properties_are_the_motions(walk, walk_clip):
 
 def test_sampling_is_appendix_a(walk_clip):
     rule = walk_clip.info["tangent_rule"]
-    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343, 400, -3])
+    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343])
     got = walk_clip.sample_frames(positions)
-    assert got.dtype == np.float32 and got.shape == (10, 96)
+    assert got.dtype == np.float32 and got.shape == (8, 96)
     for c in range(walk_clip.channel_count):
         info = walk_clip.channel(c)
         frames, values = walk_clip.channel_keys(c)
@@ -215,6 +215,55 @@ def test_from_motion_keeps_every_frame(keyanim, walk, tmp_path):
     assert np.array_equal(f, np.arange(344))
     assert clip.channel(c) == {"interpolation": "cardinal", "tension": 0.0, "key_count": 344}
     assert clip.sample_frames(10.5)[c] == appendix_a(f, v, "cardinal", 0.0, "step_adjusted", 10.5)
+
+
+def test_positions_outside_the_clip_are_refused(keyanim, walk_clip):
+    # As `keyanim sample --frame 1000` (exit 1): not clamped to the last frame (issue 28, item 18).
+    calls = (lambda f: walk_clip.world_positions(frames=f), lambda f: walk_clip.sample_frames(f),
+             lambda f: walk_clip.local_transforms(frames=f))
+    for call in calls:
+        for bad in ([1000], [0, 344], [-1], [-0.5], [343.0001]):
+            with pytest.raises(keyanim.Error) as info:
+                call(bad)
+            assert info.value.kind == "invalid_argument"
+            assert "frame %.9g is not in the clip" % [b for b in bad if not 0 <= b <= 343][0] in str(info.value)
+            assert "344 frames, 0 to 343" in str(info.value)
+    for t in ([100.0], [-0.1], [walk_clip.duration * 1.001]):
+        with pytest.raises(keyanim.Error, match=r"time .* s is not in the clip \(it has 344 frames, times 0 to"):
+            walk_clip.sample(t)
+        with pytest.raises(keyanim.Error, match="is not in the clip"):
+            walk_clip.world_positions(t)
+    # The ends are in the clip: frame 343, and the duration (which rounding may put a hair past it).
+    assert walk_clip.world_positions(frames=[0, 343]).shape == (2, 38, 3)
+    assert walk_clip.sample(np.linspace(0, walk_clip.duration, 7)).shape == (7, 96)
+    assert walk_clip.fps == pytest.approx(1 / 0.0083333) and walk_clip.duration == pytest.approx(343 * 0.0083333)
+
+
+def test_a_bvh_file_is_pointed_to_read_bvh(keyanim, walk_bvh):
+    from conftest import WALK
+    for source in (WALK, open(WALK, "rb").read()):
+        with pytest.raises(keyanim.Error) as info:
+            keyanim.Clip(source)
+        assert "is BVH text, not a .kanim" in str(info.value), str(info.value)
+        assert "keyanim.read_bvh" in str(info.value) and "Clip.from_motion" in str(info.value)
+
+
+def test_info_parses_the_notes(keyanim, walk_clip, walk_encoded):
+    info = walk_clip.info
+    notes = info["notes"]
+    # Every key=value line of the notes, a number where the text is one.
+    lines = dict(line.split("=", 1) for line in info["encoder_notes"].splitlines() if "=" in line)
+    assert set(notes) == set(lines)
+    for key, text in lines.items():
+        try:
+            want = float(text)
+        except ValueError:
+            want = text
+        assert notes[key] == want, (key, notes[key], text)
+    assert isinstance(notes["rounds"], int) and notes["tolerance"] == "0.05%"
+    # The notes keep six significant digits.
+    assert notes["max_error"] == float("%.6g" % walk_encoded[1]["error"]["max"])
+    assert notes["worst_point"] == walk_encoded[1]["error"]["worst_point"]
 
 
 def test_argument_errors(keyanim, walk_clip):

@@ -114,8 +114,24 @@ def test_bad_setting_types(keyanim, walk):
                    dict(shell=None), dict(shell=True), dict(shell=[2])):
         with pytest.raises(TypeError):
             keyanim.encode(walk, **kwargs)
-    with pytest.raises(TypeError):
-        keyanim.encode("walk.bvh")
+    # Not a motion nor a path: a TypeError saying what encode takes, not pybind's signature list.
+    for bad in (3, None, [1, 2]):
+        with pytest.raises(TypeError, match=r"encode\(\) takes a keyanim.Motion .* or the path of a BVH file"):
+            keyanim.encode(bad)
+
+
+def test_encode_takes_a_path(keyanim, walk, tmp_path):
+    import pathlib
+    from conftest import WALK
+    want = keyanim.encode(walk, error="0.5%")
+    for path in (str(WALK), pathlib.Path(WALK), bytes(str(WALK), "utf-8")):
+        data, report = keyanim.encode(path, error="0.5%")
+        assert data == want[0] and report["input"] == str(WALK) and report["bvh_bytes"] == want[1]["bvh_bytes"]
+    with pytest.raises(FileNotFoundError):
+        keyanim.encode(tmp_path / "missing.bvh")
+    (tmp_path / "w.kanim").write_bytes(want[0])
+    with pytest.raises(keyanim.Error, match="is a .kanim file, expected BVH text"):
+        keyanim.encode(tmp_path / "w.kanim")
 
 
 def test_manual_frame_beyond_the_motion(keyanim, walk):

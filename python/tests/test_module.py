@@ -38,4 +38,4 @@ def test_readme_example_runs(tmp_path, monkeypatch):
     os.symlink(REPO / "data", tmp_path / "data")
     monkeypatch.chdir(tmp_path)
     exec(compile(code, "README.md", "exec"), {})
-    assert (tmp_path / "copy.bvh").exists()
+    assert (tmp_path / "scratch" / "copy.bvh").exists()

@@ -85,6 +85,30 @@ def test_read_bvh_file_errors(keyanim, tmp_path):
         keyanim.read_bvh(42)
 
 
+def test_read_bvh_of_a_kanim_says_what_the_tool_says(keyanim, walk_encoded, tmp_path):
+    # One message for one mistake (issue 28, item 18): the CLI's, not the reader's "found '\x89KAN'".
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(walk_encoded[0])
+    with pytest.raises(keyanim.Error) as info:
+        keyanim.read_bvh(path)
+    tool = cli("encode", path, "-o", tmp_path / "x.kanim", check=False)
+    assert tool.returncode == 2
+    assert str(info.value) == "%s: is a .kanim file, expected BVH text" % path
+    assert tool.stderr.strip() == "keyanim: " + str(info.value)
+
+
+def test_fps_and_duration(keyanim, walk, tmp_path):
+    assert walk.fps == 1 / 0.0083333 and walk.duration == 343 * 0.0083333
+    # One frame, and no frame time: duration 0, fps None.
+    still = tmp_path / "still.bvh"
+    still.write_text("HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 1 Zrotation\n End Site\n {\n  OFFSET 0 1 0\n"
+                     " }\n}\nMOTION\nFrames: 1\nFrame Time: 0\n5\n")
+    m = keyanim.read_bvh(still)
+    assert m.frame_count == 1 and m.duration == 0.0 and m.fps is None
+    clip = keyanim.Clip.from_motion(walk)
+    assert clip.fps == walk.fps and clip.duration == pytest.approx(walk.duration)
+
+
 def test_write_bvh_round_trip_and_refusals(keyanim, walk, tmp_path):
     out = tmp_path / "walk.bvh"
     walk.write_bvh(out)

@@ -141,6 +141,127 @@ directory)
   expect_rc 2 "$K" eval in -j 2 --error 0.5%
   grep -q 'a.bvh' "$T/.stdout" || die "eval skipped the good files"
   ;;
+output_names)
+  # An output's name says what it holds (issue 28, item 12): a name whose extension is another
+  # format's is refused (exit 1, naming the file and the right extension) before any work, and
+  # nothing is written; --to states the format and lets any name through.
+  "$K" -q encode "$WALK" -o w.kanim || die "encode"
+  refused() {  # refused NAME WANT command...: exit 1, the message names NAME and WANT, no file
+    local name=$1 want=$2; shift 2
+    expect_rc 1 "$@"
+    grep -q "$name: this writes .*name it .*$want" "$T/.stderr" || die "'$*': the refusal does not name $name and $want: $(cat "$T/.stderr")"
+    [ ! -e "$name" ] || die "'$*' left $name"
+    [ -z "$(ls -a | grep '\.tmp\.')" ] || die "'$*' left a temporary file"
+  }
+  refused walk.fbx .bvh "$K" decode w.kanim -o walk.fbx
+  grep -q -- '--to bvh' "$T/.stderr" && grep -q '.glb' "$T/.stderr" || die "decode's refusal does not offer --to or glTF: $(cat "$T/.stderr")"
+  refused walk.mp4 .bvh "$K" decode w.kanim -o walk.mp4 --fps 30
+  refused out.bvh .kanim "$K" encode "$WALK" -o out.bvh
+  grep -q -- '--to kanim' "$T/.stderr" || die "encode's refusal does not offer --to kanim: $(cat "$T/.stderr")"
+  refused c.png .svg "$K" plot "$WALK" --channel Hips:Xrotation -o c.png
+  refused f.png .svg "$K" render w.kanim -o f.png
+  refused p.txt .html "$K" view w.kanim -o p.txt --no-open
+  refused rd.png .svg "$K" eval "$WALK" --error 1% --svg rd.png
+  refused r.txt .jsonl "$K" eval "$WALK" --error 1% --report r.txt
+  printf '%s\n' "$WALK" >list.txt
+  refused r.csv .jsonl "$K" encode --manifest list.txt -o mout --report r.csv
+  [ ! -e mout ] || die "a refused manifest run encoded"
+  # What is written is what the name or --to says: BVH text in walk.mp4, a .kanim in x.bin.
+  expect_rc 0 "$K" decode w.kanim -o walk.mp4 --to bvh
+  [ "$("$K" info walk.mp4 --json | json 'd["format"]')" = "bvh" ] || die "--to bvh did not write BVH"
+  expect_rc 0 "$K" encode "$WALK" -o x.bin --to kanim
+  [ "$("$K" info x.bin --json | json 'd["format"]')" = "kanim" ] || die "--to kanim did not write a .kanim"
+  expect_rc 0 "$K" plot "$WALK" --channel Hips:Xrotation -o c.xml --to svg
+  head -c 200 c.xml | grep -q '<svg' || die "--to svg did not write SVG"
+  expect_rc 1 "$K" encode "$WALK" -o y.kanim --to bvh   # encode writes one format
+  [ ! -e y.kanim ] || die "a wrong --to left an output"
+  mkdir -p in; cp "$WALK" in/a.bvh
+  expect_rc 1 "$K" encode in -o dout --to kanim         # outputs named by the run: no --to
+  # Case does not matter, a name without an extension and a device are not checked, and an
+  # input stays protected first (exit 4, not 1).
+  expect_rc 0 "$K" decode w.kanim -o WALK.BVH
+  expect_rc 0 "$K" decode w.kanim -o WALK.GLB
+  [ "$(head -c 4 WALK.GLB)" = "glTF" ] || die "an upper-case .GLB did not get glTF"
+  expect_rc 0 "$K" decode w.kanim -o noext
+  expect_rc 0 "$K" -f decode w.kanim -o /dev/null
+  expect_rc 4 "$K" -f encode "$WALK" -o "$WALK"
+  ;;
+summaries)
+  # A batch run that succeeds says so in one line on standard error (issue 28, item 13):
+  # inputs, bytes in and out (the files' own sizes), the worst error and the time; -q: nothing.
+  mkdir -p in/sub; cp "$WALK" in/a.bvh; cp "$HOP" in/sub/b.bvh
+  "$K" encode in -o out 2>err >std || die "encode DIR"
+  [ ! -s std ] || die "the summary went to standard output: $(cat std)"
+  [ "$(wc -l <err)" = 1 ] || die "encode DIR printed $(wc -l <err) lines, expected one: $(cat err)"
+  bvh=$(( $(stat -c %s in/a.bvh) + $(stat -c %s in/sub/b.bvh) ))
+  kan=$(( $(stat -c %s out/a.kanim) + $(stat -c %s out/sub/b.kanim) ))
+  grep -q "^in -> out: 2 inputs, 2 encoded in [0-9.]* s; $bvh bytes of BVH -> $kan bytes of .kanim" err ||
+    die "the summary does not give 2 inputs, $bvh bytes in and $kan out: $(cat err)"
+  # The worst error is the input's closest to its tolerance, as its own encode reports it.
+  worst=$("$K" -f encode in -o out --json | json 'max(d["files"], key=lambda f: f["error"]["max"] / f["tolerance"])["error"]["max"]')
+  python3 - "$worst" "$(sed -n 's/.*worst error \([^,]*\),.*/\1/p' err)" <<'PY' || die "worst error: $(cat err), --json says $worst"
+import sys; a, b = map(float, sys.argv[1:]); sys.exit(0 if abs(a - b) <= 1e-5 * a else 1)
+PY
+  expect_rc 0 "$K" -q -f encode in -o out
+  [ ! -s "$T/.stderr" ] || die "-q printed: $(cat "$T/.stderr")"
+  # A manifest: encoded, skipped and failed inputs are counted.
+  echo garbage >in/bad.bvh
+  printf 'in/a.bvh\nin/sub/b.bvh\nin/bad.bvh\n' >list.txt
+  "$K" encode --manifest list.txt -o mout 2>err; [ $? = 2 ] || die "a manifest with a bad input: not exit 2"
+  grep -q "^list.txt -> mout: 3 inputs, 2 encoded, 1 failed in" err || die "manifest summary: $(cat err)"
+  "$K" encode --manifest list.txt -o mout --skip-existing 2>err
+  grep -q "^list.txt -> mout: 3 inputs, 0 encoded, 2 skipped, 1 failed in [0-9.]* s$" err || die "manifest summary with skips: $(cat err)"
+  printf 'in/a.bvh\n' >one.txt
+  expect_rc 0 "$K" -q encode --manifest one.txt -o qout
+  [ ! -s "$T/.stderr" ] || die "-q printed: $(cat "$T/.stderr")"
+  ;;
+mismatch)
+  # Two inputs that cannot be compared are one rule, exit 2 (README's exit table): verify,
+  # render and view --against alike; 5 stays for a check that ran and failed (issue 28, item 19).
+  "$K" -q encode "$WALK" -o w.kanim || die "encode"
+  printf 'HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n0 0 0\n1 1 1\n' >other.bvh
+  expect_rc 2 "$K" verify w.kanim --against other.bvh
+  grep -q 'other.bvh: not the same skeleton or frame count as w.kanim' "$T/.stderr" || die "verify's refusal: $(cat "$T/.stderr")"
+  expect_rc 2 "$K" verify w.kanim --against other.bvh --max-error 1% --json
+  [ ! -s "$T/.stdout" ] || die "verify printed a result for inputs it could not compare: $(cat "$T/.stdout")"
+  expect_rc 2 "$K" verify w.kanim --against "$HOP"       # the same skeleton, another frame count
+  expect_rc 2 "$K" render w.kanim --against other.bvh -o r.svg
+  printf '<html><body><!-- keyanim:embed --></body></html>\n' >page.html
+  KEYANIM_VIEWER_PAGE=$T/page.html DISPLAY='' WAYLAND_DISPLAY='' expect_rc 2 "$K" view w.kanim --against other.bvh -o v.html --no-open
+  [ ! -e v.html ] && [ ! -e r.svg ] || die "a refused comparison left an output"
+  # The same pair that matches: exit 0, and 5 only when the check itself fails.
+  KEYANIM_VIEWER_PAGE=$T/page.html DISPLAY='' WAYLAND_DISPLAY='' expect_rc 0 "$K" view w.kanim --against "$WALK" -o v.html --no-open
+  expect_rc 0 "$K" verify w.kanim --against "$WALK"
+  expect_rc 5 "$K" verify w.kanim --against "$WALK" --max-error 0.0001%
+  ;;
+gltf_rate)
+  # glTF at another rate (issue 28, item 17): --fps keys are samples, not fitted; when the
+  # export is past the clip's tolerance a warning says by how much and why (keys 1/F s apart,
+  # between which the worst frame falls), and none is printed within it or with -q.
+  "$K" -q encode "$WALK" -o w.kanim || die "encode"
+  "$K" decode w.kanim -o w30.glb --fps 30 2>err || die "decode --fps 30"
+  python3 - <<'PY' || die "the warning: $(cat err)"
+import re
+text = open("err").read()
+m = re.search(r"error max ([0-9.e+-]+) \(.*, frame (\d+)\), tolerance ([0-9.e+-]+)", text)
+error, frame, tol = float(m[1]), int(m[2]), float(m[3])
+assert error > 10 * tol, (error, tol)
+w = re.search(r"keyanim: warning: w.kanim: with --fps 30 the export is [0-9.e+-]+ from the clip \(.*, frame (\d+)\), "
+              r"(\d+)x its tolerance .*keys 1/30 s apart.*source frames ([0-9.]+) and ([0-9.]+); the clip has a frame "
+              r"every .*120 fps\)\. The error is measured at every source frame", text)
+assert w, text
+assert int(w[1]) == frame and abs(int(w[2]) - error / tol) <= 1, (w.groups(), error / tol)
+a, b = float(w[3]), float(w[4])
+assert a <= frame <= b and b - a == 4, (a, b, frame)   # 120 fps / 30 fps: a key every 4 frames
+PY
+  "$K" -q decode w.kanim -o q30.glb --fps 30 2>err || die "decode -q --fps 30"
+  [ ! -s err ] || die "-q printed: $(cat err)"
+  for opts in "--fps 120" ""; do
+    # shellcheck disable=SC2086
+    "$K" decode w.kanim -o "x${opts// /}.glb" $opts 2>err || die "decode $opts"
+    grep -q warning err && die "a warning within the tolerance ($opts): $(cat err)"
+  done
+  ;;
 *) die "unknown case $CASE" ;;
 esac
 echo "ok: $CASE"

@@ -4,6 +4,7 @@
 #         with one point per tolerance, log axes labelled with their units;
 # report: the JSON lines match eval --json, and each total's bytes per second is the files'
 #         bytes over their frames x frame time, recomputed here.
+# table:  the text table: names, columns, alignment and totals (recomputed from --json);
 # acl:    --acl TABLE: ACL's bytes at each file's error interpolated log-log between the rows
 #         that bracket it (the nearest row outside them), the ratio, and per group the median
 #         and worst ratio, all recomputed here from a table written here.
@@ -119,6 +120,51 @@ PY
   expect_rc 2 "$K" eval lib --acl missing.tsv
   printf 'a\tb\n1\t2\n' >bad.tsv
   expect_rc 2 "$K" eval lib --acl bad.tsv
+  ;;
+table)
+  # The table (issue 28, item 14): names relative to the inputs' directory, whole (not cut);
+  # with several key modes a mode column, the setting column holding settings only, every row
+  # aligned; a total row per setting, its figures recomputed here from --json.
+  mkdir -p lib/sub; cp "$WALK" lib/sub/a_long_name_for_a_clip_of_someone_walking_slowly_in_a_lab.bvh
+  opts=(--error 0.5% --keys error+uniform:10+curvature -j 2)
+  "$K" eval lib "${opts[@]}" >table.txt 2>/dev/null || die "eval"
+  "$K" eval lib "${opts[@]}" --json >eval.json 2>/dev/null || die "eval --json"
+  python3 - <<'PY' || die "the table: $(cat table.txt)"
+import json
+lines = open("table.txt").read().splitlines()
+files = json.load(open("eval.json"))["files"]
+head, rows = lines[0], lines[1:]
+assert head.startswith("file, below lib/ "), head
+assert len({len(l) for l in lines}) == 1, "rows of different lengths:\n" + "\n".join(lines)
+col = {name: head.index(name) for name in ("keys mode", "--error")}
+names = sorted(f["file"][len("lib/"):] for f in files)
+assert "sub/a_long_name_for_a_clip_of_someone_walking_slowly_in_a_lab.bvh" in names, names
+body, totals = rows[:-3], rows[-3:]
+assert len(body) == 3 * len(files), rows
+for line in body:
+    name = line[:col["keys mode"]].strip()
+    assert name in names, (name, names)
+    mode = line[col["keys mode"]:].split()[0]
+    assert mode in ("error", "uniform:10", "curvature"), line
+    setting = line[col["keys mode"] + len(mode):].split()[0]
+    assert setting == "0.5%", line
+for line, mode in zip(totals, ("error", "uniform:10", "curvature")):
+    assert line.startswith("total (3 files) "), line
+    w = line[col["keys mode"]:].split()
+    assert w[0] == mode and w[1] == "0.5%", line
+    rs = [r for f in files for r in f["results"] if r["key_mode"] == mode]
+    keys, size = sum(r["keys"] for r in rs), sum(r["kanim_bytes"] for r in rs)
+    raw = sum(f["raw_f32_bytes"] for f in files)
+    assert int(w[2]) == keys and int(w[3]) == size, (line, keys, size)
+    assert abs(float(w[4]) - raw / size) <= 0.005, (line, raw / size)
+    assert float(w[7]) == float("%.4g" % max(r["error"]["max"] for r in rs)), line
+    samples = [f["frames"] * f["nodes"] for f in files]
+    rms = (sum(r["error"]["rms"] ** 2 * n for r, n in zip(rs, samples)) / sum(samples)) ** 0.5
+    assert float(w[8]) == float("%.4g" % rms), (line, rms)
+PY
+  # One file: no total row, and the tolerance heading in error mode.
+  "$K" eval "$WALK" --error 1% >one.txt 2>/dev/null || die "eval one file"
+  [ "$(wc -l <one.txt)" = 2 ] && head -n1 one.txt | grep -q ' tolerance ' || die "one file's table: $(cat one.txt)"
   ;;
 *) die "unknown case $CASE" ;;
 esac

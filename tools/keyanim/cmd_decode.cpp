@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "gltf_output.h"
 #include "io.h"
 #include "progress.h"
@@ -24,7 +25,8 @@ const char* const kDecodeHelp =
     "                        any other, frames every 1/F s up to the clip's end.\n"
     "  --inbetweens N        N extra frames in every source frame interval (default 0; BVH only)\n"
     "  --frames A:B          source frames A to B inclusive (default: all; A <= B < frame count)\n"
-    "  --to bvh|gltf         output format (default: by the output's extension, .glb/.gltf: glTF)\n"
+    "  --to bvh|gltf         output format (default: by the output's extension, .glb/.gltf: glTF).\n"
+    "                        Without it, a name that says another format (walk.fbx) is refused\n"
     "The BVH is written as it is decoded (memory does not grow with its length); a request for\n"
     "more than --max-values values (frames x channels) is refused before any is made (exit 6).\n"
     "glTF 2.0 output (.gltf writes its buffer to OUT.bin beside it; '-' gets a .glb): one node per\n"
@@ -63,7 +65,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
 
   Input input(in, g);
   if (gltf) return decode_gltf(input, out, opt, args, g);
-  Output output(out, false, g, ids_of({&input}));
+  Output output(out, false, g, ids_of({&input}), bvh_format(args.has("--to")));
   const Clip clip = load_kanim(in, input.read(Kind::kanim), g);
   // (Given, not the UINT32_MAX default: --frames 0:4294967295 was taken for "to the end".)
   if (args.has("--frames") && opt.last_frame >= clip.frame_count())

@@ -9,17 +9,19 @@
 #include "keyanim/offline/container.h"
 #include "batch.h"
 #include "escape.h"
+#include "formats.h"
 #include "encode_one.h"
 #include "io.h"
 #include "manifest.h"
 #include "progress.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
+#include "tally.h"
 
 namespace keyanim::cli {
 
 const char* const kEncodeHelp =
-    "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--error E|E%] [--shell D|D%]\n"
+    "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--to kanim] [--error E|E%] [--shell D|D%]\n"
     "                      [--keys MODE] [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
     "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
     "                      [--report R.jsonl] [--error E|E%] [--shell D|D%] [--keys MODE] [-j N] [-f]\n"
@@ -31,6 +33,8 @@ const char* const kEncodeHelp =
     "                        and skipped, and the exit code is then non-zero. Outputs that\n"
     "                        would collide (m.bvh and m.BVH), exist (without -f) or are inputs\n"
     "                        stop the run before any file is encoded.\n"
+    "  --to kanim            write the .kanim under a name that does not end in .kanim (without\n"
+    "                        it, a name that says another format, out.bvh, is refused)\n"
     "  -j N                  threads (default and most: one per core): a file's channels, or\n"
     "                        a directory's (or a manifest's) files\n"
     "  --manifest LIST       encode every path listed (one per line; '-': standard input) to the\n"
@@ -46,9 +50,9 @@ const char* const kEncodeHelp =
 // the input); the output is written only when everything else has succeeded. Memory: the BVH
 // text goes once parsed, the motion's values once encoded. With `bar`, the stages show on it.
 Encoded encode_one(const std::string& in, const std::string& out, offline::EncodeSettings settings,
-                   bool error_given, const Globals& g, Progress* bar) {
+                   bool error_given, bool to_given, const Globals& g, Progress* bar) {
   Input input(in, g);
-  Output output(out, true, g, ids_of({&input}));
+  Output output(out, true, g, ids_of({&input}), kanim_format(to_given));
   EncodeProgress progress(bar, settings.key_mode == offline::KeyMode::error);
   offline::Motion motion;
   size_t bvh_size = 0;
@@ -120,6 +124,7 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
     targets.push_back(swap_extension((std::filesystem::path(out) / rel).string(), ".kanim"));
   }
   check_outputs(files, targets, g);
+  EncodeTally tally;
   std::vector<Encoded> results(files.size());
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
@@ -129,27 +134,35 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
     std::error_code mk;
     std::filesystem::create_directories(dir, mk);
     if (mk) fail(kOutputFailed, dir.string() + ": cannot create: " + mk.message());
-    results[i] = encode_one(files[i], targets[i], settings, error_given, quiet);
+    results[i] = encode_one(files[i], targets[i], settings, error_given, false, quiet);
   }, files);
   nlohmann::json all = nlohmann::json::array();
   for (const Encoded& r : results) {
     if (r.summary.is_null()) continue;
     all.push_back(r.summary);
+    tally.encoded(r.summary);
     print_warning(r, g);
     if (!json && g.verbosity > 1) std::cerr << human_line(r.summary) << "\n";
   }
   if (json) std::cout << json_text({{"files", all}, {"failed", files.size() - all.size()}}) << "\n";
+  else if (g.verbosity > 0) std::cerr << tally.line(in, out, files.size()) << "\n";
   return code;
 }
 
 }  // namespace
 
 int cmd_encode(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "-j"}, flags{"--json"};
+  std::set<std::string> valued{"-o", "--output", "-j", "--to"}, flags{"--json"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   valued.insert(std::begin(kManifestValuedOptions), std::end(kManifestValuedOptions));
   flags.insert(std::begin(kManifestFlags), std::end(kManifestFlags));
   const Args args(argv, valued, flags);
+  const bool to_kanim = stated_format(args, "kanim");
+  std::error_code ec;
+  const bool directory = args.positional().size() == 1 && args.positional()[0] != "-" &&
+                         std::filesystem::is_directory(args.positional()[0], ec);
+  if (to_kanim && (args.has("--manifest") || directory))
+    fail(kUsage, "--to names the format of one output file; a directory or manifest run names each output .kanim");
   if (args.has("--manifest")) return encode_manifest(args, encode_settings(args), g);
   for (const char* o : {"--shard", "--report", "--skip-existing"})
     if (args.has(o)) fail(kUsage, std::string(o) + " goes with --manifest LIST");
@@ -159,13 +172,12 @@ int cmd_encode(const Argv& argv, Globals& g) {
   std::string out = args.get("-o").value_or("");
   const bool json = args.has("--json");
 
-  std::error_code ec;
-  if (in != "-" && std::filesystem::is_directory(in, ec)) return encode_directory(in, out, settings, args, json, g);
+  if (directory) return encode_directory(in, out, settings, args, json, g);
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, ".kanim");
   if (json && out == "-") fail(kUsage, "--json and the .kanim would both go to standard output: give -o FILE");
   settings.threads = thread_count(args);  // one file: its channels in parallel
   Progress bar(g, in);
-  const Encoded e = encode_one(in, out, settings, args.has("--error"), g, &bar);
+  const Encoded e = encode_one(in, out, settings, args.has("--error"), to_kanim, g, &bar);
   bar.erase();
   if (json) std::cout << json_text(e.summary) << "\n";
   else if (g.verbosity > 0) std::cerr << human_line(e.summary) << "\n";

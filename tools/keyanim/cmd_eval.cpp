@@ -15,6 +15,7 @@
 #include "eval_report.h"
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
@@ -32,7 +33,9 @@ const char* const kEvalHelp =
     "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
     "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
     "by zstd -19, the max and RMS world-space error of joints, End Sites and shell points with\n"
-    "the worst point and frame, and the encode and decode times. Nothing is written.\n"
+    "the worst point and frame, and the encode and decode times. Nothing is written. The table\n"
+    "names files below the inputs' common directory, and ends with a total row per setting\n"
+    "(sums, ratios of the sums, the largest error, the RMS error over every file's frames).\n"
     "  --error LIST          comma-separated tolerances, each E or E% (default 0.05%,0.5%)\n"
     "  --svg RD.svg          compression ratio against error, log axes: a line per file, or\n"
     "                        with several key modes a line per mode over every file\n"
@@ -88,6 +91,7 @@ nlohmann::json eval_file(const std::string& path, const std::vector<EvalRun>& ru
   nlohmann::json file = {{"file", path},
                          {"frames", m.frame_count},
                          {"channels", m.channel_count()},
+                         {"nodes", m.skeleton.joints.size()},
                          {"frame_time", m.frame_time},
                          {"seconds", m.frame_count * m.frame_time},
                          {"size", size},
@@ -154,14 +158,6 @@ nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
   return out;
 }
 
-// " ACL bytes  x ACL" of a result, or nothing without a comparison.
-std::string acl_columns(const nlohmann::json& r) {
-  if (!r.contains("acl")) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, " %10.0f %7.3f", r["acl"]["bytes"].get<double>(), r["acl"]["ratio"].get<double>());
-  return buf;
-}
-
 void print_acl_summary(const nlohmann::json& summary) {
   for (const auto& [run, groups] : summary.items())
     for (const auto& [group, g] : groups.items())
@@ -193,8 +189,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
   for (const std::string& f : files)
     if (auto id = input_id(f)) ids.push_back(*id);
   std::optional<Output> svg, report;
-  if (auto path = args.get("--svg")) svg.emplace(*path, false, g, ids);
-  if (auto path = args.get("--report")) report.emplace(*path, false, g, ids);
+  if (auto path = args.get("--svg")) svg.emplace(*path, false, g, ids, svg_format(false, false));
+  if (auto path = args.get("--report")) report.emplace(*path, false, g, ids, json_lines_format());
   std::vector<nlohmann::json> results(files.size());
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
@@ -224,27 +220,8 @@ int cmd_eval(const Argv& argv, Globals& g) {
     std::cout << json_text(out) << "\n";
     return code;
   }
-  const bool applied = runs.front().settings.key_mode == offline::KeyMode::error;  // else --error is not a tolerance
-  const bool modes = runs.front().keys != runs.back().keys;  // several key modes: say which
-  const bool with_acl = args.has("--acl");
-  std::printf("%-40s %9s %8s %9s %7s %7s %7s %10s %10s %9s %9s%s\n", "file", applied ? "tolerance" : "--error", "keys",
-              "bytes", "x raw", "x bvh", "x zstd", "max error", "rms error", "enc ms", "dec ms",
-              with_acl ? "  ACL bytes   x ACL" : "");
-  for (const auto& f : results) {
-    if (f.is_null()) continue;
-    std::string name = printable(f["file"].get<std::string>());
-    if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
-    for (const auto& r : f["results"])
-      std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f%s\n", name.c_str(),
-                  printable((modes ? r["key_mode"].get<std::string>() + " " : std::string()) +
-                            r[r.contains("tolerance") ? "tolerance" : "error_limit"].get<std::string>())
-                      .c_str(),
-                  r["keys"].get<unsigned long long>(), r["kanim_bytes"].get<unsigned long long>(),
-                  r["ratio_raw_f32"].get<double>(), r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(),
-                  r["error"]["max"].get<double>(), r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(),
-                  r["decode_ms"].get<double>(), acl_columns(r).c_str());
-  }
-  if (with_acl) print_acl_summary(summary);
+  std::fputs(eval_table(results, args.has("--acl")).c_str(), stdout);
+  if (args.has("--acl")) print_acl_summary(summary);
   return code;
 }
 

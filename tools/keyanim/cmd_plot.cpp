@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "figures.h"
 #include "settings.h"
@@ -12,7 +13,7 @@
 namespace keyanim::cli {
 
 const char* const kPlotHelp =
-    "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--frames A:B]\n"
+    "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--to svg] [--frames A:B]\n"
     "                    [--error E|E%] [--shell D|D%] [--keys MODE] [--tension T|fit]\n"
     "                    [--level N] [-f]\n"
     "Encodes IN with the given settings and draws one channel over the frames: the original curve\n"
@@ -23,7 +24,9 @@ const char* const kPlotHelp =
     "  --frames A:B          draw frames A..B only, inclusive (default: all; A: or :B leave one\n"
     "                        end open). The whole clip is encoded either way.\n"
     "  -o, --output FILE     SVG output (default: IN without extension + -JOINT-CHANNEL.svg;\n"
-    "                        '-' = standard output)\n";
+    "                        '-' = standard output)\n"
+    "  --to svg              write the SVG under a name that does not end in .svg (without it,\n"
+    "                        a name that says another format, curve.png, is refused)\n";
 
 namespace {
 
@@ -38,7 +41,7 @@ std::string file_safe(const std::string& s) {
 }  // namespace
 
 int cmd_plot(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "--channel", "--frames"};
+  std::set<std::string> valued{"-o", "--output", "--channel", "--frames", "--to"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {});
   if (args.positional().size() != 1) fail(kUsage, "plot takes one BVH file");
@@ -46,6 +49,7 @@ int cmd_plot(const Argv& argv, Globals& g) {
   if (!spec) fail(kUsage, "plot needs --channel JOINT:CHANNEL");
   const offline::EncodeSettings settings = encode_settings(args);
   const std::string in = args.positional()[0];
+  const bool to_svg = stated_format(args, "svg");
 
   std::string out = args.get("-o").value_or("");
   if (out.empty()) {
@@ -64,7 +68,7 @@ int cmd_plot(const Argv& argv, Globals& g) {
   }
 
   Input input(in, g);
-  Output output(out, false, g, ids_of({&input}));
+  Output output(out, false, g, ids_of({&input}), svg_format(to_svg));
   const offline::Motion motion = load_bvh_bytes(in, input.read(Kind::bvh), g);
   std::string error;
   const std::optional<uint32_t> channel = find_channel(motion.skeleton, *spec, error);
@@ -80,8 +84,12 @@ int cmd_plot(const Argv& argv, Globals& g) {
   output.write(plot.svg);
   output.commit();
   if (g.verbosity > 0)
-    std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << plot.key_count << " keys shown of "
-              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "\n";
+    std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << count_of(plot.key_count, "key") << " shown of "
+              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "; alone, it moves a point by "
+              << plot.channel_world_error << " at most ("
+              << printable(plot.channel_world_point) << ", frame " << plot.channel_world_frame << "), "
+              << (plot.tolerance_units > 0 ? plot.channel_world_error / plot.tolerance_units : 0.0) << "x the "
+              << (settings.key_mode == offline::KeyMode::error ? "tolerance " : "--error ") << plot.tolerance_units << "\n";
   return kOk;
 }
 

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "conventions.h"
 #include "figures.h"
@@ -21,7 +22,7 @@
 namespace keyanim::cli {
 
 const char* const kRenderHelp =
-    "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg]\n"
+    "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg] [--to svg]\n"
     "                      [--position-channels replace|add] [--up y|z|auto] [--error E|E%]\n"
     "                      [--shell D|D%] [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
@@ -35,6 +36,8 @@ const char* const kRenderHelp =
     "  --against OTHER       a second file to compare with\n"
     "  -o, --output FILE     SVG output (default: IN without extension + -frameN.svg;\n"
     "                        '-' = standard output)\n"
+    "  --to svg              write the SVG under a name that does not end in .svg (without it,\n"
+    "                        a name that says another format, frame.png, is refused)\n"
     "  --position-channels replace|add\n"
     "                        how position channels below the root combine with OFFSET: replace\n"
     "                        it (Blender; default) or add to it (three.js). When the file has\n"
@@ -108,7 +111,7 @@ struct Poses {
 }  // namespace
 
 int cmd_render(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels", "--up"};
+  std::set<std::string> valued{"-o", "--output", "--frame", "--against", "--position-channels", "--up", "--to"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   const Args args(argv, valued, {});
   if (args.positional().size() != 1) fail(kUsage, "render takes one input file");
@@ -119,6 +122,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   const uint32_t frame_option = args.get_uint("--frame", 0);  // parsed before any work
   const PositionReading reading = position_reading(args);
   const std::optional<UpAxis> up_option = up_axis_option(args);
+  const bool to_svg = stated_format(args, "svg");
   auto name_of = [](const std::string& p) {
     return p == "-" ? std::string("(stdin)") : std::filesystem::path(p).filename().string();
   };
@@ -133,7 +137,8 @@ int cmd_render(const Argv& argv, Globals& g) {
     fail(kUsage, "--frame " + std::to_string(frame) + " is past the last frame (" + std::to_string(poses.frame_count() - 1) + ")");
   std::string out = args.get("-o").value_or("");
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, "") + "-frame" + std::to_string(frame) + ".svg";
-  Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}));
+  Output output(out, false, g, ids_of(other ? std::vector<const Input*>{&input, &*other} : std::vector<const Input*>{&input}),
+                svg_format(to_svg));
 
   const offline::Motion first = poses.one_frame(frame);
   offline::Motion second;

@@ -28,8 +28,9 @@ const char* const kVerifyHelp =
     "  --shell D|D%          shell distance (file units, or percent of the skeleton size; 0:\n"
     "                        none). Default: the one IN was encoded with (its notes), else 2%\n"
     "  --json                one JSON object on standard output\n"
-    "Exit 0 when every check passes, 2 for a damaged file, 3 for an unsupported version,\n"
-    "5 when a check fails.\n";
+    "Exit 0 when every check passes, 2 for a damaged file or an ORIG that is not the clip's\n"
+    "(another skeleton or frame count: nothing to compare, as for render and view --against),\n"
+    "3 for an unsupported version, 5 when --max-error fails.\n";
 
 namespace {
 
@@ -63,26 +64,27 @@ int cmd_verify(const Argv& argv, Globals& g) {
     // clip declares.
     const bool same_layout = orig.frame_count == clip.frame_count() && orig.channel_count() == clip.channel_count() &&
                              orig.skeleton.joints.size() == clip.skeleton().joints.size();
-    if (!same_layout) {
-      ok = false;
-      why = "the clip's skeleton or frame count differs from " + *orig_path;
-    } else {
-      const offline::Motion back = or_fail(kBadInput, in + ": ", [&] { return offline::decode_motion(clip); });
-      // The same layout: checked above.
-      const offline::ErrorReport e = offline::measure_error(orig, back, shell_units(shell, clip, orig));
-      j["error"] = offline::error_json(orig.skeleton, e);
-      if (limit) {
-        const offline::EncodeSettings& s = *limit;
-        const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::reference_size(orig) : s.tolerance;
-        j["max_error_allowed"] = units;
-        if (!(e.max_error <= units)) {
-          ok = false;
-          // Shortest round-trip text: to_string's %f printed a tolerance of 1e-9 as 0.000000.
-          why = "error " + json_text(e.max_error) + " exceeds " + json_text(units);
-        }
+    // Inputs that cannot be compared are exit 2, as for render and view --against (README's
+    // exit table): 5 is a check that ran and failed, and none ran.
+    if (!same_layout)
+      fail(kBadInput, *orig_path + ": not the same skeleton or frame count as " + in + " (" +
+                          count_of(orig.frame_count, "frame") + " and " + count_of(orig.skeleton.joints.size(), "node") +
+                          " against " + count_of(clip.frame_count(), "frame") + " and " +
+                          count_of(clip.skeleton().joints.size(), "node") + "): nothing to compare");
+    const offline::Motion back = or_fail(kBadInput, in + ": ", [&] { return offline::decode_motion(clip); });
+    const offline::ErrorReport e = offline::measure_error(orig, back, shell_units(shell, clip, orig));
+    j["error"] = offline::error_json(orig.skeleton, e);
+    if (limit) {
+      const offline::EncodeSettings& s = *limit;
+      const double units = s.tolerance_in_percent ? s.tolerance / 100.0 * offline::reference_size(orig) : s.tolerance;
+      j["max_error_allowed"] = units;
+      if (!(e.max_error <= units)) {
+        ok = false;
+        // Shortest round-trip text: to_string's %f printed a tolerance of 1e-9 as 0.000000.
+        why = "error " + json_text(e.max_error) + " exceeds " + json_text(units);
       }
-      if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + offline::error_text(orig.skeleton, e)) << "\n";
     }
+    if (!args.has("--json") && g.verbosity > 0) std::cerr << printable(in + ": error " + offline::error_text(orig.skeleton, e)) << "\n";
   }
   j["ok"] = ok;
   if (args.has("--json")) std::cout << json_text(j) << "\n";

@@ -16,6 +16,7 @@
 
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "svg.h"  // escape(): the same escaping serves an HTML attribute
 
@@ -24,11 +25,13 @@ extern char** environ;
 namespace keyanim::cli {
 
 const char* const kViewHelp =
-    "usage: keyanim view IN.kanim [--against ORIG.bvh] [-o OUT.html] [--no-open] [-f]\n"
+    "usage: keyanim view IN.kanim [--against ORIG.bvh] [-o OUT.html] [--to html] [--no-open] [-f]\n"
     "Writes a copy of the browser viewer with IN (and ORIG) embedded: one HTML file that plays\n"
     "the clip as a 3D skeleton, decoded in the page, offline. Prints the file's path and opens\n"
     "it with xdg-open when a display is available (DISPLAY or WAYLAND_DISPLAY set).\n"
     "  -o, --output FILE     the page (default: a new file in the temporary directory)\n"
+    "  --to html             write the page under a name that does not end in .html or .htm\n"
+    "                        (without it, a name that says another format is refused)\n"
     "  --against ORIG.bvh    also embed the original, overlaid, with the largest distance per frame\n"
     "  --no-open             write and print the path only\n"
     "The viewer page is taken from $KEYANIM_VIEWER_PAGE if set, else from\n"
@@ -124,25 +127,31 @@ void open_in_browser(const std::string& path, const Globals& g) {
 }  // namespace
 
 int cmd_view(const Argv& argv, Globals& g) {
-  const Args args(argv, {"-o", "--output", "--against"}, {"--no-open"});
+  const Args args(argv, {"-o", "--output", "--against", "--to"}, {"--no-open"});
   if (args.positional().size() != 1) fail(kUsage, "view takes one .kanim file");
   const std::string in = args.positional()[0];
   std::optional<std::string> out = args.get("-o");
+  const bool to_html = stated_format(args, "html");
   if (out && *out == "-") fail(kUsage, "view writes a file (its path is printed); use -o FILE.html");
-  const std::string page_template = read_page();  // before the work: a missing page is exit 3 at once
-
-  // Inputs and the output are opened and checked before anything is read.
+  // Inputs and a named output are opened and checked before anything is read (an input is
+  // never the output: exit 4; a name that says another format: exit 1), then the page is
+  // found (exit 3 at once if it is missing), and only then a temporary page made for it.
   Input clip_input(in, g);
   std::optional<Input> orig_input;
   if (auto orig = args.get("--against")) orig_input.emplace(*orig, g);
-  Globals write = g;
-  if (!out) {
-    out = temporary_page(in);
-    write.force = true;  // the empty file just made for it
-  }
   std::vector<const Input*> inputs = {&clip_input};
   if (orig_input) inputs.push_back(&*orig_input);
-  Output output(*out, false, write, ids_of(inputs));
+  std::optional<Output> named;
+  if (out) named.emplace(*out, false, g, ids_of(inputs), html_format(to_html));
+  const std::string page_template = read_page();
+  std::optional<Output> temporary;
+  if (!out) {
+    out = temporary_page(in);
+    Globals write = g;
+    write.force = true;  // the empty file just made for it
+    temporary.emplace(*out, false, write, ids_of(inputs), html_format(to_html));
+  }
+  Output& output = named ? *named : *temporary;
 
   const std::vector<uint8_t> clip_bytes = clip_input.read(Kind::kanim);
   const Clip clip = load_kanim(in, clip_bytes, g);  // the page decodes it again; a bad file fails here, clearly

@@ -27,6 +27,13 @@ std::vector<EvalRun> eval_runs(const Args& args);
 // total ratio at each tolerance).
 std::string eval_svg(const std::vector<nlohmann::json>& files);
 
+// The table `eval` prints: a row per file and run, names relative to the inputs' common
+// directory (the header says which), a key-mode column when several modes ran, columns as wide
+// as their content, then (for two files or more) a total row per run over every file (keys and bytes summed, ratios of
+// the sums, the largest max error, the RMS error pooled over every file's nodes and frames, in
+// the files' length units). With `acl`, the ACL columns of results that have them.
+std::string eval_table(const std::vector<nlohmann::json>& files, bool acl);
+
 // The same figures as JSON lines: one per file and run, then one total per run ("total":
 // true) with the bytes per second of motion over every file (seconds = frames x frame time).
 std::string eval_jsonl(const std::vector<nlohmann::json>& files);

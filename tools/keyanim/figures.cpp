@@ -79,6 +79,23 @@ std::string settings_text(const offline::EncodeSettings& s, double tolerance_uni
   return t;
 }
 
+namespace {
+
+// The original with `channel` alone replaced by the clip's reconstruction, measured as every
+// error is (metrics.h): what this one curve costs in world space.
+offline::ErrorReport channel_alone_error(const offline::Motion& motion, const Clip& clip, uint32_t channel, double shell) {
+  offline::Motion mixed = motion;
+  const size_t stride = motion.channel_count();
+  for (uint32_t f = 0; f < motion.frame_count; ++f) {
+    float v = 0.0f;
+    (void)clip.sample_channel(channel, static_cast<float>(f), v);  // the channel exists, f is finite
+    mixed.values[size_t(f) * stride + channel] = double(v);
+  }
+  return offline::measure_error(motion, mixed, shell);
+}
+
+}  // namespace
+
 bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& settings, uint32_t channel,
                   const std::string& file_label, ChannelPlot& out, std::string& error, FrameRange range) {
   out = {};
@@ -129,7 +146,7 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
 
   // Plot area and the reconstruction's sampling: between frames too when a frame is wide
   // enough for the spline's shape to show (otherwise one sample per frame).
-  const svg::Rect area{84, 72, 856, 310};
+  const svg::Rect area{84, 88, 856, 310};
   const double px_per_frame = last > first ? area.w / double(last - first) : area.w;
   const uint32_t steps = static_cast<uint32_t>(std::clamp(std::floor(px_per_frame / 3.0), 1.0, 8.0));
   std::vector<double> recon_pos, recon;
@@ -150,6 +167,11 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   out.channel_keys = static_cast<uint32_t>(key_frames.size());
   out.max_channel_error = result.error.channel_max.size() > channel ? result.error.channel_max[channel] : 0.0;
   out.tolerance_units = result.tolerance_units;
+  const offline::ErrorReport alone = channel_alone_error(motion, clip, channel, result.shell_units);
+  out.channel_world_error = alone.max_error;
+  out.channel_world_point = offline::point_name(sk, alone.worst_joint, alone.worst_point);
+  out.channel_world_frame = alone.worst_frame;
+  const bool applied = settings.key_mode == offline::KeyMode::error;  // else --error only guided quantization
   const std::string unit = rotation ? "degrees" : "file units";
   const std::string spec = sk.joints[joint].name + ":" + channel_name(type);
   const bool whole = first == 0 && last == n - 1;
@@ -161,13 +183,20 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
                                  std::to_string(result.total_keys) + " in the clip; max channel error " +
                                  short_number(out.max_channel_error) + " " + unit + "; max joint error " +
                                  short_number(result.error.max_error) + " file units";
-  // Wider than the plot when the heading needs it (a long file name), never clipped.
-  const double width = std::max({960.0, area.x + svg::text_width(heading, 14, true) + 24, area.x + svg::text_width(subheading) + 24});
-  svg::Document doc(width, 440);
+  const double share = out.tolerance_units > 0.0 ? out.channel_world_error / out.tolerance_units : 0.0;
+  const std::string world = "this channel's reconstruction alone moves a point by " +
+                            short_number(out.channel_world_error) + " file units at most (" + out.channel_world_point +
+                            ", frame " + std::to_string(out.channel_world_frame) + "): " + short_number(share) +
+                            "x the " + (applied ? "tolerance " : "--error ") + short_number(out.tolerance_units);
+  // Wider than the plot when a heading needs it (a long file name), never clipped.
+  const double width = std::max({960.0, area.x + svg::text_width(heading, 14, true) + 24,
+                                 area.x + svg::text_width(subheading) + 24, area.x + svg::text_width(world) + 24});
+  svg::Document doc(width, 440 + 16);
   const svg::Axes axes(area, {double(first), double(last)}, svg::nice_range({lo - pad, hi + pad}, 6));
   doc.title(file_label + " " + spec + ": original and reconstruction" + shown);
   doc.text({84, 22}, heading, attr("class", "title") + " font-size=\"14\" font-weight=\"bold\"");
   doc.text({84, 40}, subheading, attr("class", "subtitle") + " fill=\"#444\"");
+  doc.text({84, 58}, world, attr("class", "subtitle world") + " fill=\"#444\"");
   axes.draw(doc, "frame", std::string(channel_name(type)) + " (" + unit + ")", 10, 6);
 
   std::vector<svg::Point> pts;
@@ -188,9 +217,9 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   doc.close_group();
   const std::vector<svg::LegendEntry> entries{
       {"original", kOriginalColour, false, 3.5},
-      {"reconstructed (" + std::to_string(out.key_count) + " keys" + (whole ? "" : " shown") + ")", kReconColour,
+      {"reconstructed (" + count_of(out.key_count, "key") + (whole ? "" : " shown") + ")", kReconColour,
        true, 1.2}};
-  svg::legend(doc, {area.x + area.w - svg::legend_width(entries), 60}, entries);
+  svg::legend(doc, {area.x + area.w - svg::legend_width(entries), 76}, entries);
   out.svg = doc.finish();
   return true;
 }

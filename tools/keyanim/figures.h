@@ -28,6 +28,13 @@ struct ChannelPlot {
   uint32_t channel_keys = 0;       // keys of the channel in the whole clip
   double max_channel_error = 0.0;  // degrees (modulo 360) or file units, at the source frames
   double tolerance_units = 0.0;    // the encoder's tolerance in file length units
+  // What this channel's reconstruction alone does in world space (issue 28, item 16): the
+  // largest distance any joint, End Site or shell point moves when only this channel is
+  // replaced by its reconstruction, where and when (a flat curve that reads as a bias is then
+  // seen to be within the tolerance, or not).
+  double channel_world_error = 0.0;
+  std::string channel_world_point;
+  uint32_t channel_world_frame = 0;
 };
 
 // Frames first..last, inclusive; `last` is clamped to the clip.
@@ -40,6 +47,8 @@ struct FrameRange {
 // every frame of `range` (and between frames when a frame is at least 6 px wide) and draws it
 // over the original (a rotation's original unwrapped, the reconstruction shifted by a multiple
 // of 360 degrees to start beside it). Every key in the range is a dot on the reconstruction.
+// A subtitle line gives the world-space error this channel's reconstruction alone causes,
+// against the tolerance.
 // `file_label` names the input in the title. Returns false with `error` set if the encoder
 // refuses the motion or settings, or the range holds no frame.
 bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& settings, uint32_t channel,

@@ -201,7 +201,23 @@ std::vector<FileId> ids_of(const std::vector<const Input*>& inputs) {
   return ids;
 }
 
-Output::Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs)
+void check_output_name(const std::string& path, const OutputFormat& format) {
+  if (path == "-" || format.stated) return;
+  std::string ext = fs::path(path).extension().string();
+  if (ext.empty()) return;
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) return;
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (std::find(format.extensions.begin(), format.extensions.end(), ext) != format.extensions.end()) return;
+  std::string names;
+  for (size_t i = 0; i < format.extensions.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == format.extensions.size() ? " or " : ", ") + format.extensions[i];
+  fail(kUsage, path + ": this writes " + format.what + ", which a " + ext + " name does not say; name it " + names +
+                   (format.to.empty() ? "" : ", or give " + format.to + " to keep this name") + format.note);
+}
+
+Output::Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs,
+               const OutputFormat& format)
     : path_(path), force_(g.force) {
   if (path == "-") {
     if (binary && isatty(STDOUT_FILENO) && !g.force)
@@ -214,6 +230,7 @@ Output::Output(const std::string& path, bool binary, const Globals& g, const std
   // An existing device, pipe or link to one (-f -o /dev/null), or a link to this process's own
   // standard output or error (-o /dev/stdout), is written in place, never renamed over.
   check_target(path, inputs, g.force);
+  check_output_name(path, format);
   fd_ = offline::open_in_place(path);
   if (fd_ == -2) fail(kOutputFailed, path + ": cannot open: " + std::strerror(errno));
   if (fd_ >= 0) return;

@@ -62,13 +62,30 @@ class Input {
 std::vector<uint8_t> read_input(const std::string& path, Kind kind, const Globals& g);
 offline::Motion load_bvh(const std::string& path, const Globals& g);
 
+// What an output holds, so that its name can be checked against it: `walk.fbx` holding BVH
+// text, or `out.bvh` holding .kanim bytes, misleads every program that opens the file later.
+struct OutputFormat {
+  std::string what;                     // "BVH text", for the message
+  std::vector<std::string> extensions;  // the names it may end with, lower case: {".bvh"}
+  std::string to;                       // the option that states it ("--to bvh"), or "" if none
+  bool stated = false;                  // the user stated it (--to): any name goes
+  std::string note;                     // appended to the refusal: what other names would write
+};
+
+// Refuses (exit 1, usage) a name whose extension is none of `format`'s, unless the format was
+// stated. Not checked: standard output ("-"), a name without an extension (/dev/stdout,
+// `out`), and an existing device or FIFO (written in place: its name is not the user's choice).
+void check_output_name(const std::string& path, const OutputFormat& format);
+
 class Output {
  public:
   // Checks and opens `path` ("-": standard output) now, before the work: exit 4 if it exists
   // (without --force), is a directory, is one of `inputs`, or its directory is missing or not
-  // writable; binary data is not sent to a terminal without --force. A regular file is written
-  // to a new temporary file beside it; an existing device or pipe is written in place.
-  Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs);
+  // writable; then exit 1 if its name does not say `format` (check_output_name); binary data
+  // is not sent to a terminal without --force. A regular file is written to a new temporary
+  // file beside it; an existing device or pipe is written in place.
+  Output(const std::string& path, bool binary, const Globals& g, const std::vector<FileId>& inputs,
+         const OutputFormat& format);
   ~Output();  // without commit(): the temporary file is removed
   Output(const Output&) = delete;
   Output& operator=(const Output&) = delete;

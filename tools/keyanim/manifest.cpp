@@ -20,7 +20,9 @@
 #include "batch.h"
 #include "encode_one.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
+#include "tally.h"
 #include "keyanim/clip.h"
 
 namespace keyanim::cli {
@@ -175,12 +177,13 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
   // (i + count could wrap around with a huge N and take every entry: step only while it fits.)
   for (uint64_t i = shard.index; i < all.size(); i = all.size() - i > shard.count ? i + shard.count : all.size())
     inputs.push_back(all[size_t(i)]);
-  if (!report_path.empty()) check_report(report_path, list, inputs);
+  if (!report_path.empty()) check_report(report_path, list, inputs), check_output_name(report_path, json_lines_format());
   const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
   Report report(report_path);
 
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
+  EncodeTally tally;
   offline::EncodeSettings one = settings;
   one.threads = 1;  // files in parallel, each on one thread
   const int code = run_batch(inputs.size(), thread_count(args), g, [&](size_t i) {
@@ -200,6 +203,7 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
           line.update({{"status", "skipped"}, {"bytes", fs::file_size(out, ec)}, {"max_error", noted_error(clip)},
                        {"seconds", seconds_since(t0)}});
           if (!done.count(in)) report.add(line);
+          tally.skipped();
           return;
         }
         mine.force = true;  // damaged or incomplete: replaced
@@ -209,7 +213,8 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
       if (skip_existing) mine.force = true;
       fs::create_directories(fs::path(out).parent_path(), ec);
       if (ec) fail(kOutputFailed, fs::path(out).parent_path().string() + ": cannot create: " + ec.message());
-      const nlohmann::json r = encode_one(in, out, one, args.has("--error"), mine).summary;
+      const nlohmann::json r = encode_one(in, out, one, args.has("--error"), false, mine).summary;
+      tally.encoded(r);
       line.update({{"status", "ok"}, {"bytes", r["kanim_bytes"]}, {"max_error", r["error"]["max"]},
                    {"tolerance", r.value("tolerance", r.value("error_limit", 0.0))}, {"seconds", seconds_since(t0)}});
       report.add(line);
@@ -224,6 +229,7 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
       throw;
     }
   }, inputs);
+  if (g.verbosity > 0) std::cerr << tally.line(list == "-" ? "(standard input)" : list, outdir, inputs.size()) << "\n";
   return code;
 }
 

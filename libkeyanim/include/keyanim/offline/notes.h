@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace keyanim::offline {
 
@@ -12,5 +14,8 @@ namespace keyanim::offline {
 std::optional<std::string> note(const std::string& notes, std::string_view key);
 // The same read as a finite number, or nullopt.
 std::optional<double> note_number(const std::string& notes, std::string_view key);
+// Every key=value line, in order, the first of a repeated key only (as note() reads them);
+// lines without '=' or with an empty key are not notes and are left out.
+std::vector<std::pair<std::string, std::string>> note_lines(const std::string& notes);
 
 }  // namespace keyanim::offline

@@ -1,5 +1,6 @@
 #include "offline/encode/notes.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -61,6 +62,21 @@ std::optional<double> note_number(const std::string& notes, std::string_view key
   const auto [end, ec] = std::from_chars(text->data(), text->data() + text->size(), v);
   if (ec != std::errc() || end != text->data() + text->size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+std::vector<std::pair<std::string, std::string>> note_lines(const std::string& notes) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (size_t at = 0; at < notes.size();) {
+    const size_t end = std::min(notes.find('\n', at), notes.size());
+    const std::string_view line(notes.data() + at, end - at);
+    at = end + 1;
+    const size_t eq = line.find('=');
+    if (eq == std::string_view::npos || eq == 0) continue;
+    std::string key(line.substr(0, eq));
+    if (std::none_of(out.begin(), out.end(), [&](const auto& kv) { return kv.first == key; }))
+      out.emplace_back(std::move(key), std::string(line.substr(eq + 1)));
+  }
+  return out;
 }
 
 }  // namespace keyanim::offline

@@ -1,6 +1,7 @@
 #include "keyanim/offline/report.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -132,6 +133,28 @@ nlohmann::json bvh_info(const std::string& file, uint64_t bytes, const offline::
   return j;
 }
 
+namespace {
+
+// The notes as an object, key -> value: a value that is a whole finite number (max_error=0.013,
+// rounds=21) as a number, any other as its text (tolerance=0.05%, worst_point=...).
+nlohmann::json notes_json(const std::string& notes) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [key, value] : offline::note_lines(notes)) {
+    int64_t whole = 0;
+    const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), whole);
+    if (ec == std::errc() && end == value.data() + value.size() && !value.empty()) {
+      out[key] = whole;
+      continue;
+    }
+    const std::string line = key + "=" + value;
+    const std::optional<double> number = offline::note_number(line, key);
+    out[key] = number ? nlohmann::json(*number) : nlohmann::json(value);
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& clip) {
   nlohmann::json j = {{"file", file},
                       {"format", "kanim"},
@@ -175,6 +198,7 @@ nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& c
   std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(clip.rig_hash()));
   j["rig_hash"] = hash;  // equal for clips of one rig (Clip::rig_hash)
   j["encoder_notes"] = clip.encoder_notes();
+  j["notes"] = notes_json(clip.encoder_notes());
   if (nlohmann::json noted = guarantee_json(clip.encoder_notes()); !noted.empty()) j["guarantee"] = noted;
   return j;
 }
