@@ -10,8 +10,9 @@
 #  3. every session of the README (blocks of "$ " lines) pasted line by line, printing what the
 #     README shows (tests/newcomer/readme_session.py), leaving nothing in the checkout (they
 #     write under the ignored scratch/); outputs named for another format (walk.fbx) refused;
-#  4. every command's --help read for options described twice and incomplete usage lines
-#     (tests/cli/help_test.py); `man keyanim`, the bash completion and `import keyanim` found;
+#  4. every command's --help read for options described twice and incomplete usage lines, and
+#     the README's usage block against it (tests/cli/help_test.py); `man keyanim`, the bash
+#     completion and `import keyanim` found;
 #  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
 #     as skipped with their reason, and no test may pass without checking anything
 #     (tests/ctest_report.py).
@@ -64,7 +65,7 @@ refused scratch/curve.png .svg keyanim plot data/cmu_02_01_walk.bvh --channel Hi
 echo "outputs named for another format are refused: $(head -n1 "$T/refused.err")"
 
 step "4. every command's help; man keyanim; bash completion; import keyanim"
-"$PY" tests/cli/help_test.py "$(command -v keyanim)"
+"$PY" tests/cli/help_test.py "$(command -v keyanim)" README.md
 man -w keyanim | grep -q "^$KEYANIM_PREFIX/" || { echo "newcomer: FAIL: man keyanim does not find the installed page"; exit 1; }
 [ -f "$KEYANIM_PREFIX/share/bash-completion/completions/keyanim" ] || { echo "newcomer: FAIL: no bash completion installed"; exit 1; }
 echo "man page and completion installed"

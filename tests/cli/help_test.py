@@ -8,6 +8,9 @@
   every option it names is described (by the command or among the global options); the command
   accepts every option it describes.
 - Short global flags combine (-qV prints the bare version; -qv, -vq and -fq are accepted).
+- With README.md as a second argument: the README's usage block (the first ``` block under
+  "## Using the tool") names, for every command, exactly the options its usage lines name, so
+  that the README cannot fall behind the tool (issue 28, item 6).
 
 Also run by the newcomer check (scripts/newcomer.sh) on the installed tool.
 """
@@ -50,6 +53,37 @@ def usage_options(text, command):
             break
         usage.append(line)
     return set(OPTION.findall(" ".join(usage).replace(f"keyanim {command}", "")))
+
+
+def readme_usage(path):
+    """Per command, the options of its lines in the README's usage block; and the global line's."""
+    text = open(path, encoding="utf-8").read()
+    block = text.split("\n## Using the tool\n", 1)[1].split("```", 2)[1]
+    per_command, global_line = {}, set()
+    for line in block.splitlines():
+        if line.startswith("keyanim "):
+            command = line.split()[1]
+            per_command.setdefault(command, set()).update(OPTION.findall(line.replace(f"keyanim {command}", "")))
+        elif line.startswith("global options"):
+            global_line = set(OPTION.findall(line))
+    return per_command, global_line
+
+
+def check_readme(keyanim, readme, commands, fail):
+    per_command, global_line = readme_usage(readme)
+    for c in commands:
+        if c == "help":
+            continue
+        if c not in per_command:
+            fail(f"README: the usage block has no line for {c}")
+            continue
+        text = run(keyanim, "help", c)[1]
+        named = usage_options(text, c) - global_line
+        shown = per_command[c] - global_line
+        for s in sorted(named - shown):
+            fail(f"README: the usage block's {c} leaves out {s}, which 'keyanim {c} --help' names")
+        for s in sorted(shown - named):
+            fail(f"README: the usage block's {c} names {s}, which 'keyanim {c} --help' does not")
 
 
 def check_command(keyanim, command, fail):
@@ -101,6 +135,8 @@ def main():
     for c in commands:
         if c != "help":
             check_command(keyanim, c, fail)
+    if len(sys.argv) > 2:
+        check_readme(keyanim, sys.argv[2], commands, fail)
 
     version = run(keyanim, "--version")[1].split()[1]
     for flags in ("-qV", "-Vq"):
