@@ -12,7 +12,8 @@
 #     write under the ignored scratch/); outputs named for another format (walk.fbx) refused;
 #  4. every command's --help read for options described twice and incomplete usage lines, and
 #     the README's usage block against it (tests/cli/help_test.py); `man keyanim`, the bash
-#     completion and `import keyanim` found;
+#     completion and `import keyanim` found; the README's glTF sizes of data/ remade
+#     (tests/docs/gltf_table_check.py);
 #  5. the README's test command, without its sanitizer stage: CTest must report the corpus tests
 #     as skipped with their reason, and no test may pass without checking anything
 #     (tests/ctest_report.py).
@@ -66,6 +67,7 @@ echo "outputs named for another format are refused: $(head -n1 "$T/refused.err")
 
 step "4. every command's help; man keyanim; bash completion; import keyanim"
 "$PY" tests/cli/help_test.py "$(command -v keyanim)" README.md
+"$PY" tests/docs/gltf_table_check.py "$(command -v keyanim)" .  # the README's glTF sizes of data/
 man -w keyanim | grep -q "^$KEYANIM_PREFIX/" || { echo "newcomer: FAIL: man keyanim does not find the installed page"; exit 1; }
 [ -f "$KEYANIM_PREFIX/share/bash-completion/completions/keyanim" ] || { echo "newcomer: FAIL: no bash completion installed"; exit 1; }
 echo "man page and completion installed"
