@@ -34,14 +34,15 @@ KEYANIM_INLINE inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c)
 }
 
 // The rotations of a group's nodes [begin, end) (indices into the group), out[node - first].
-KEYANIM_INLINE inline void group_rotations(const Rig& img, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
-                     const float* values, uint32_t column0, uint32_t first, Transform* out) noexcept {
-  const uint32_t* node = img.group_node.data() + g.node_first;
+KEYANIM_INLINE inline void group_rotations(const Rig& rig, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
+                                           const float* values, uint32_t column0, uint32_t first,
+                                           Transform* out) noexcept {
+  const uint32_t* node = rig.group_node.data() + g.node_first;
   for (uint32_t i = begin; i < end; i += 4) {
     const uint32_t lanes = std::min(4u, end - i);
     Quat4 q{F4(0.0f), F4(0.0f), F4(0.0f), F4(1.0f)};
     for (uint32_t k = 0; k < g.steps; ++k) {
-      const uint32_t* column = img.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
+      const uint32_t* column = rig.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
       alignas(16) float angle[4] = {0.0f, 0.0f, 0.0f, 0.0f};
       for (uint32_t l = 0; l < lanes; ++l) angle[l] = values[column[l] - column0];
       F4 s, c;
@@ -63,21 +64,21 @@ KEYANIM_INLINE inline uint32_t lower_index(const uint32_t* sorted, uint32_t n, u
 // The products and sums of the scalar twins below, in their order, lanes x, y, z (w): a - b is
 // a + (-b) and (-a) b is -(a b) exactly, so the bits are the scalar twins' (tests/scalar).
 template <int a, int b, int c, int d>
-[[gnu::always_inline]] inline __m128 shuffle(__m128 v) noexcept {
+KEYANIM_INLINE inline __m128 shuffle(__m128 v) noexcept {
   return _mm_shuffle_ps(v, v, _MM_SHUFFLE(d, c, b, a));
 }
-[[gnu::always_inline]] inline __m128 flip(__m128 v, bool x, bool y, bool z, bool w) noexcept {
+KEYANIM_INLINE inline __m128 flip(__m128 v, bool x, bool y, bool z, bool w) noexcept {
   return _mm_xor_ps(v, _mm_castsi128_ps(_mm_set_epi32(w ? INT32_MIN : 0, z ? INT32_MIN : 0, y ? INT32_MIN : 0,
                                                       x ? INT32_MIN : 0)));
 }
-[[gnu::always_inline]] inline __m128 multiply(__m128 a, __m128 b) noexcept {
+KEYANIM_INLINE inline __m128 multiply(__m128 a, __m128 b) noexcept {
   const __m128 t1 = _mm_mul_ps(shuffle<3, 3, 3, 3>(a), b);
   const __m128 t2 = _mm_mul_ps(shuffle<0, 0, 0, 0>(a), flip(shuffle<3, 2, 1, 0>(b), false, true, false, true));
   const __m128 t3 = _mm_mul_ps(shuffle<1, 1, 1, 1>(a), flip(shuffle<2, 3, 0, 1>(b), false, false, true, true));
   const __m128 t4 = _mm_mul_ps(shuffle<2, 2, 2, 2>(a), flip(shuffle<1, 0, 3, 2>(b), true, false, false, true));
   return _mm_add_ps(_mm_add_ps(_mm_add_ps(t1, t2), t3), t4);
 }
-[[gnu::always_inline]] inline __m128 rotate_vector(__m128 q, __m128 v) noexcept {
+KEYANIM_INLINE inline __m128 rotate_vector(__m128 q, __m128 v) noexcept {
   const __m128 cross = _mm_sub_ps(_mm_mul_ps(shuffle<1, 2, 0, 3>(q), shuffle<2, 0, 1, 3>(v)),
                                   _mm_mul_ps(shuffle<2, 0, 1, 3>(q), shuffle<1, 2, 0, 3>(v)));
   const __m128 t = _mm_mul_ps(_mm_set1_ps(2.0f), cross);

@@ -25,13 +25,14 @@ struct Fnv {
 
 // The pose tables (Rig::node_offset, rot_groups, moves): nodes grouped by their rotation
 // axes in order of first appearance, each group's columns step by step.
-void build_pose_tables(Rig& img) {
+void build_pose_tables(Rig& rig) {
   std::vector<std::vector<uint32_t>> members;  // per group, its nodes
-  const auto& joints = img.skeleton.joints;
+  std::unordered_map<uint32_t, uint32_t> group_of;
+  const auto& joints = rig.skeleton.joints;
   for (uint32_t node = 0; node < joints.size(); ++node) {
     const Joint& j = joints[node];
-    for (double o : j.offset) img.node_offset.push_back(static_cast<float>(o));
-    img.node_offset.push_back(0.0f);
+    for (double o : j.offset) rig.node_offset.push_back(static_cast<float>(o));
+    rig.node_offset.push_back(0.0f);
     Rig::RotationGroup key{};
     for (size_t k = 0; k < j.channels.size(); ++k) {
       const uint32_t column = j.first_channel + static_cast<uint32_t>(k);
@@ -39,30 +40,29 @@ void build_pose_tables(Rig& img) {
       if (is_rotation(j.channels[k]))
         key.axis[key.steps++] = static_cast<uint8_t>(axis);
       else
-        img.moves.push_back({node, column, axis});
+        rig.moves.push_back({node, column, axis});
     }
-    auto same = [&](const Rig::RotationGroup& g) {
-      return g.steps == key.steps && std::equal(g.axis, g.axis + g.steps, key.axis);
-    };
-    const size_t g = size_t(std::find_if(img.rot_groups.begin(), img.rot_groups.end(), same) - img.rot_groups.begin());
-    if (g == img.rot_groups.size()) {
-      img.rot_groups.push_back(key);
+    uint32_t code = key.steps;  // the axis sequence as a number: one lookup per node
+    for (uint32_t k = 0; k < key.steps; ++k) code = code * 3 + key.axis[k];
+    const auto [at, added] = group_of.try_emplace(code, static_cast<uint32_t>(rig.rot_groups.size()));
+    if (added) {
+      rig.rot_groups.push_back(key);
       members.emplace_back();
     }
-    members[g].push_back(node);
+    members[at->second].push_back(node);
   }
-  for (size_t i = 0; i < img.rot_groups.size(); ++i) {
-    Rig::RotationGroup& g = img.rot_groups[i];
-    g.node_first = static_cast<uint32_t>(img.group_node.size());
+  for (size_t i = 0; i < rig.rot_groups.size(); ++i) {
+    Rig::RotationGroup& g = rig.rot_groups[i];
+    g.node_first = static_cast<uint32_t>(rig.group_node.size());
     g.node_count = static_cast<uint32_t>(members[i].size());
-    g.column_first = static_cast<uint32_t>(img.group_column.size());
-    img.group_node.insert(img.group_node.end(), members[i].begin(), members[i].end());
+    g.column_first = static_cast<uint32_t>(rig.group_column.size());
+    rig.group_node.insert(rig.group_node.end(), members[i].begin(), members[i].end());
     for (uint32_t k = 0; k < g.steps; ++k)
       for (uint32_t node : members[i]) {
         const Joint& j = joints[node];
         uint32_t seen = 0;  // the node's k-th rotation channel
         for (size_t c = 0; c < j.channels.size(); ++c)
-          if (is_rotation(j.channels[c]) && seen++ == k) img.group_column.push_back(j.first_channel + uint32_t(c));
+          if (is_rotation(j.channels[c]) && seen++ == k) rig.group_column.push_back(j.first_channel + uint32_t(c));
       }
   }
 }
