@@ -2,6 +2,7 @@
 of failure: outputs that destroy something, reads that never end, buffers that crash."""
 
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -150,3 +151,51 @@ def test_encode_settings_out_of_range_say_so(keyanim, walk):
         keyanim.encode(walk, level=True)
     with pytest.raises(keyanim.Error, match="threads is out of range"):
         keyanim.encode(walk, threads=-2 ** 63 - 1)
+
+
+# Class 6: the bytes of a .kanim do not depend on the process's locale.
+def comma_locale(tmp_path):
+    """(name, extra environment) of a locale whose decimal point is a comma: an installed one
+    (`locale -a`), else de_DE.UTF-8 compiled by localedef into tmp_path (glibc finds it through
+    LOCPATH), so that no system locale needs to be installed. None when neither can be had."""
+    probe = "import locale, sys; locale.setlocale(locale.LC_ALL, sys.argv[1]); print(locale.localeconv()['decimal_point'])"
+    def decimal_point(name, env):
+        r = subprocess.run([sys.executable, "-c", probe, name], capture_output=True, text=True, env=env)
+        return r.stdout.strip() if r.returncode == 0 else None
+    listed = subprocess.run(["locale", "-a"], capture_output=True, text=True).stdout.split() if shutil.which("locale") else []
+    for name in sorted(listed, key=lambda n: not n.startswith("de_DE")):
+        if is_utf8(name) and decimal_point(name, dict(os.environ)) == ",":
+            return name, {}
+    if shutil.which("localedef"):
+        subprocess.run(["localedef", "-i", "de_DE", "-f", "UTF-8", str(tmp_path / "de_DE.UTF-8")], capture_output=True)
+        env = dict(os.environ, LOCPATH=str(tmp_path))
+        if decimal_point("de_DE.UTF-8", env) == ",":
+            return "de_DE.UTF-8", {"LOCPATH": str(tmp_path)}
+    return None
+
+
+def is_utf8(name):
+    return name.lower().replace("-", "").endswith(".utf8")
+
+
+def test_encode_writes_the_same_bytes_under_a_comma_decimal_locale(keyanim, tmp_path):
+    found = comma_locale(tmp_path)
+    if found is None:
+        pytest.skip("no comma-decimal locale: none installed (locale -a) and localedef could not compile "
+                    "de_DE.UTF-8 (Debian: apt-get install locales)")
+    name, extra = found
+    code = ("import locale, sys, keyanim\n"
+            "if sys.argv[1] != 'C': locale.setlocale(locale.LC_ALL, sys.argv[1])\n"
+            "assert locale.localeconv()['decimal_point'] == ('.' if sys.argv[1] == 'C' else ',')\n"
+            "data, report = keyanim.encode(keyanim.read_bvh(sys.argv[2]), error=0.25, tension=0.5, shell=1.5, threads=1)\n"
+            "open(sys.argv[3], 'wb').write(data)\n")
+    env = module_env()
+    env.update(extra)
+    outputs = {}
+    for loc in ("C", name):
+        out = tmp_path / ("%s.kanim" % loc)
+        subprocess.run([sys.executable, "-c", code, loc, str(WALK), str(out)], check=True, env=env)
+        outputs[loc] = out.read_bytes()
+    notes = keyanim.Clip(outputs[name]).encoder_notes
+    assert "tension=0.500000\n" in notes and "tolerance=0.25\n" in notes and "shell=1.5\n" in notes, notes
+    assert outputs[name] == outputs["C"], "the notes under %s: %r" % (name, notes)
