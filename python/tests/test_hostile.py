@@ -144,6 +144,15 @@ def test_dataset_takes_numpy_integers(keyanim):
 
 
 # Class 7: errors that say what happened.
+def test_encode_names_a_value_keys_cannot_hold_and_what_it_is(keyanim):
+    m = keyanim.read_bvh(WALK)
+    for value, said in ((float("nan"), r"is NaN \(not a number\)"), (float("-inf"), "is -inf"),
+                        (3e38, r"is 3e\+38, beyond what binary32 keys can hold")):
+        m.channels[3, 7] = value
+        with pytest.raises(keyanim.Error, match=r"^channel 7 \(\S+ [XYZ](position|rotation)\) of frame 3 " + said):
+            keyanim.encode(m)
+
+
 def test_encode_settings_out_of_range_say_so(keyanim, walk):
     with pytest.raises(keyanim.Error, match="level is out of range"):
         keyanim.encode(walk, level=2 ** 40)
