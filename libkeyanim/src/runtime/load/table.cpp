@@ -116,6 +116,7 @@ Status Loader::read_header_and_table() {
                   "decompressed sections exceed the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
     raw_total += e.raw;
   }
+  if (Status s = check_expansion(); s != Status::ok) return s;
 
   uLong crc = crc32(0L, Z_NULL, 0);
   for (uint64_t done = 0; done < pos;) {
@@ -126,6 +127,20 @@ Status Loader::read_header_and_table() {
   const uint32_t stored_crc = internal::load_le<uint32_t>(p + pos);
   if (static_cast<uint32_t>(crc) != stored_crc)
     return fail(Status::checksum_mismatch, "checksum", pos, "CRC-32 of the file does not match its checksum");
+  return Status::ok;
+}
+
+Status Loader::check_expansion() {
+  for (size_t i = 0; i < table_.size(); ++i) {
+    const TableEntry& e = table_[i];
+    const bool known = e.tag == internal::kTagNote || !(e.flags & internal::kSectionAncillary);
+    // stored <= file size < 2^48: the product is exact.
+    if (known && (e.flags & internal::kSectionCompressed) && e.raw > internal::kMaxZstdExpansion * e.stored)
+      return fail(Status::zstd_error, "table", e.entry_offset + 16,
+                  "section " + std::to_string(i) + " (" + tag_name(e.tag) + "): Raw_Size " + std::to_string(e.raw) +
+                      " is more than its " + std::to_string(e.stored) + " stored bytes can make (a zstd frame makes at most " +
+                      std::to_string(internal::kMaxZstdExpansion) + " bytes of each)");
+  }
   return Status::ok;
 }
 
