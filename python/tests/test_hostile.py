@@ -208,3 +208,64 @@ def test_encode_writes_the_same_bytes_under_a_comma_decimal_locale(keyanim, tmp_
     notes = keyanim.Clip(outputs[name]).encoder_notes
     assert "tension=0.500000\n" in notes and "tolerance=0.25\n" in notes and "shell=1.5\n" in notes, notes
     assert outputs[name] == outputs["C"], "the notes under %s: %r" % (name, notes)
+
+
+# Class 3: counts beyond what the file's size can hold are refused as they are read (spec
+# section 8: a zstd frame makes at most 32768 bytes of each of its bytes, a key takes a byte of
+# KTIM at least), through the C++ loader; a file of some hundred bytes, in a bounded interpreter.
+def crafted_kanim(frames, channels, key_count, note=None):
+    """A 3.0 file made here from spec/FORMAT.md (not by keyanim's writer): one node with
+    `channels` channels and no keys, CLIP declaring `key_count`, and optionally a compressed
+    NOTE given as (stored frame, Raw_Size)."""
+    import struct
+    import zlib
+    skel = struct.pack("<I", 1) + b"r" + struct.pack("<i3dBB", -1, 0, 0, 0, 0, channels) + bytes(range(channels))
+    clip = struct.pack("<IIIBBHdQ", frames, 1, channels, 0, 0, 0, 1 / 30, key_count)
+    chan = bytes(channels) + struct.pack("<%df" % channels, *[0.0] * channels) + \
+        struct.pack("<%dd" % channels, *[0.01] * channels) + bytes(4 * channels) + bytes(2 * channels)
+    sections = [(b"CLIP", 0, clip, 32), (b"SKEL", 0, skel, len(skel)), (b"CHAN", 0, chan, len(chan)),
+                (b"KTIM", 0, b"", 0), (b"KVAL", 0, b"", 0)]
+    if note:
+        sections.append((b"NOTE", 3, note[0], note[1]))
+    f = b"\x89KAN\r\n\x1a\n" + struct.pack("<HHIII", 3, 0, 0, len(sections), 0)
+    f += b"".join(tag + struct.pack("<IQQ", flags, len(stored), raw) for tag, flags, stored, raw in sections)
+    f += b"".join(s[2] for s in sections)
+    return f + struct.pack("<I", zlib.crc32(f))
+
+
+def rle_frame(size, byte):
+    """A zstd frame of `size` bytes of `byte` in RLE blocks of 128 KiB (4 bytes each)."""
+    import struct
+    out, left = bytearray(b"\x28\xb5\x2f\xfd\xe0" + struct.pack("<Q", size)), size
+    while True:
+        n = min(left, 1 << 17)
+        left -= n
+        out += struct.pack("<I", (n << 3) | 2 | (left == 0))[:3] + bytes([byte])
+        if left == 0:
+            return bytes(out)
+
+
+def test_counts_beyond_the_file_size_are_refused_as_read(keyanim, tmp_path):
+    ok = crafted_kanim(1 << 24, 6, 0)
+    assert keyanim.Clip(ok).total_keys == 0  # the crafting is right
+    path = tmp_path / "keys.kanim"
+    path.write_bytes(crafted_kanim(1 << 24, 6, 1 << 28))
+    note = tmp_path / "note.kanim"
+    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(64 << 10, ord("a")), 600 << 20)))
+    assert path.stat().st_size < 1000 and note.stat().st_size < 1000
+    code = ("import keyanim, sys\n"
+            "for name in sys.argv[1:]:\n"
+            "    try:\n"
+            "        keyanim.Clip(name)\n"
+            "    except keyanim.Error as e:\n"
+            "        print(e)\n")
+    script = "import resource; resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))\n" + code
+    r = subprocess.run([sys.executable, "-c", script, str(path), str(note)], capture_output=True, text=True,
+                       timeout=20, env=module_env())
+    assert r.returncode == 0, r.stderr
+    keys, notes = r.stdout.splitlines()
+    assert "Key_Count 268435456 is more than a file of %d bytes can hold" % path.stat().st_size in keys
+    assert "NOTE" in notes and "Raw_Size 629145600 is more than its" in notes
+    # The NOTE declared as what its frame makes loads.
+    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(64 << 10, ord("a")), 64 << 10)))
+    assert keyanim.Clip(str(note)).encoder_notes == "a" * (64 << 10)
