@@ -22,6 +22,7 @@
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -157,16 +158,18 @@ nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
 // " ACL bytes  x ACL" of a result, or nothing without a comparison.
 std::string acl_columns(const nlohmann::json& r) {
   if (!r.contains("acl")) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, " %10.0f %7.3f", r["acl"]["bytes"].get<double>(), r["acl"]["ratio"].get<double>());
+  char buf[64];  // printf lays out, number_text.h writes the numbers (in the C locale's form)
+  std::snprintf(buf, sizeof buf, " %10s %7s", offline::fixed_text(r["acl"]["bytes"].get<double>(), 0).c_str(),
+                offline::fixed_text(r["acl"]["ratio"].get<double>(), 3).c_str());
   return buf;
 }
 
 void print_acl_summary(const nlohmann::json& summary) {
   for (const auto& [run, groups] : summary.items())
     for (const auto& [group, g] : groups.items())
-      std::printf("against ACL, %s, %s: %zu files, median %.3f, worst %.3f (%s)\n", run.c_str(), group.c_str(),
-                  g["files"].get<size_t>(), g["median_ratio"].get<double>(), g["worst_ratio"].get<double>(),
+      std::printf("against ACL, %s, %s: %zu files, median %s, worst %s (%s)\n", run.c_str(), group.c_str(),
+                  g["files"].get<size_t>(), offline::fixed_text(g["median_ratio"].get<double>(), 3).c_str(),
+                  offline::fixed_text(g["worst_ratio"].get<double>(), 3).c_str(),
                   printable(g["worst_file"].get<std::string>()).c_str());
 }
 
@@ -235,14 +238,18 @@ int cmd_eval(const Argv& argv, Globals& g) {
     std::string name = printable(f["file"].get<std::string>());
     if (name.size() > 40) name = "..." + name.substr(name.size() - 37);
     for (const auto& r : f["results"])
-      std::printf("%-40s %9s %8llu %9llu %7.2f %7.2f %7.2f %10.4g %10.4g %9.1f %9.1f%s\n", name.c_str(),
+      std::printf("%-40s %9s %8llu %9llu %7s %7s %7s %10s %10s %9s %9s%s\n", name.c_str(),
                   printable((modes ? r["key_mode"].get<std::string>() + " " : std::string()) +
                             r[r.contains("tolerance") ? "tolerance" : "error_limit"].get<std::string>())
                       .c_str(),
                   r["keys"].get<unsigned long long>(), r["kanim_bytes"].get<unsigned long long>(),
-                  r["ratio_raw_f32"].get<double>(), r["ratio_bvh"].get<double>(), r["ratio_bvh_zstd19"].get<double>(),
-                  r["error"]["max"].get<double>(), r["error"]["rms"].get<double>(), r["encode_ms"].get<double>(),
-                  r["decode_ms"].get<double>(), acl_columns(r).c_str());
+                  offline::fixed_text(r["ratio_raw_f32"].get<double>(), 2).c_str(),
+                  offline::fixed_text(r["ratio_bvh"].get<double>(), 2).c_str(),
+                  offline::fixed_text(r["ratio_bvh_zstd19"].get<double>(), 2).c_str(),
+                  offline::general_text(r["error"]["max"].get<double>(), 4).c_str(),
+                  offline::general_text(r["error"]["rms"].get<double>(), 4).c_str(),
+                  offline::fixed_text(r["encode_ms"].get<double>(), 1).c_str(),
+                  offline::fixed_text(r["decode_ms"].get<double>(), 1).c_str(), acl_columns(r).c_str());
   }
   if (with_acl) print_acl_summary(summary);
   return code;

@@ -8,6 +8,7 @@
 #include "io.h"
 #include "figures.h"
 #include "settings.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -81,7 +82,7 @@ int cmd_plot(const Argv& argv, Globals& g) {
   output.commit();
   if (g.verbosity > 0)
     std::cerr << printable(in + " -> " + out + ": " + *spec) << ", " << plot.key_count << " keys shown of "
-              << plot.channel_keys << ", max channel error " << plot.max_channel_error << "\n";
+              << plot.channel_keys << ", max channel error " << offline::general_text(plot.max_channel_error) << "\n";
   return kOk;
 }
 
