@@ -212,7 +212,8 @@ def test_encode_writes_the_same_bytes_under_a_comma_decimal_locale(keyanim, tmp_
 
 # Class 3: counts beyond what the file's size can hold are refused as they are read (spec
 # section 8: a zstd frame makes at most 32768 bytes of each of its bytes, a key takes a byte of
-# KTIM at least), through the C++ loader; a file of some hundred bytes, in a bounded interpreter.
+# KTIM at least), and so is a NOTE above the note limit, through the C++ loader: small files,
+# in a bounded interpreter.
 def crafted_kanim(frames, channels, key_count, note=None):
     """A 3.0 file made here from spec/FORMAT.md (not by keyanim's writer): one node with
     `channels` channels and no keys, CLIP declaring `key_count`, and optionally a compressed
@@ -245,14 +246,14 @@ def rle_frame(size, byte):
             return bytes(out)
 
 
-def test_counts_beyond_the_file_size_are_refused_as_read(keyanim, tmp_path):
+def test_counts_beyond_the_file_size_and_large_notes_are_refused_as_read(keyanim, tmp_path):
     ok = crafted_kanim(1 << 24, 6, 0)
     assert keyanim.Clip(ok).total_keys == 0  # the crafting is right
     path = tmp_path / "keys.kanim"
     path.write_bytes(crafted_kanim(1 << 24, 6, 1 << 28))
-    note = tmp_path / "note.kanim"
-    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(64 << 10, ord("a")), 600 << 20)))
-    assert path.stat().st_size < 1000 and note.stat().st_size < 1000
+    note = tmp_path / "note.kanim"  # a valid 600 MiB NOTE from 19 KB of RLE blocks: above the note limit
+    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(600 << 20, ord("a")), 600 << 20)))
+    assert path.stat().st_size < 1000 and note.stat().st_size < 20000
     code = ("import keyanim, sys\n"
             "for name in sys.argv[1:]:\n"
             "    try:\n"
@@ -265,7 +266,7 @@ def test_counts_beyond_the_file_size_are_refused_as_read(keyanim, tmp_path):
     assert r.returncode == 0, r.stderr
     keys, notes = r.stdout.splitlines()
     assert "Key_Count 268435456 is more than a file of %d bytes can hold" % path.stat().st_size in keys
-    assert "NOTE" in notes and "Raw_Size 629145600 is more than its" in notes
+    assert "NOTE declares 629145600 bytes, above the limit of 16777216" in notes
     # The NOTE declared as what its frame makes loads.
     note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(64 << 10, ord("a")), 64 << 10)))
     assert keyanim.Clip(str(note)).encoder_notes == "a" * (64 << 10)

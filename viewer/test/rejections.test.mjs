@@ -107,6 +107,8 @@ const cases = {
   'Key_Count at what the file can hold': content('CLIP', (b) => { dv(b).setUint32(0, 2 ** 24, true); dv(b).setBigUint64(24, 32768n * BigInt(read('v3_rules.kanim').length), true); }),
   // A compressed section declaring more than 32768 bytes for each stored one: refused from the table.
   'Raw_Size beyond what its frame can make': edit('v3_rules.kanim', (m) => { const f = zstdRawFrame(m.sections[1].content); m.sections[1].flags |= 1; m.sections[1].stored = f; m.sections[1].rawSize = 32768 * f.length + 1; }),
+  // A NOTE above the note limit (16 MiB): refused from the table, before its frame is looked at.
+  'NOTE above its limit': edit('v3_long.kanim', (m) => { section(m, 'NOTE').rawSize = 2 ** 24 + 1; }),
   'Raw_Size at what its frame can make': edit('v3_rules.kanim', (m) => { const f = zstdRawFrame(m.sections[1].content); m.sections[1].flags |= 1; m.sections[1].stored = f; m.sections[1].rawSize = 32768 * f.length; }),
   'Key_Count differs from CHAN': content('CLIP', (b) => dv(b).setBigUint64(24, 54n, true)),
   'Channel_Count differs from SKEL': content('CLIP', (b) => dv(b).setUint32(8, 13, true)),

@@ -404,7 +404,16 @@ TEST_CASE("crafted counts beyond what the file's size can hold") {
   CHECK(load(with_keys(most)).err.section == std::string("CHAN"));
   {
     // A NOTE declaring 1 GiB - 1 MiB behind a frame of 64 KiB (a few bytes): refused at the
-    // table (before, once its frame's blocks were walked).
+    // table (before, once its frame's blocks were walked). The note limit is raised here, so
+    // that the bound is what refuses it.
+    keyanim::DecodeLimits roomy;
+    roomy.max_note_bytes = 1ull << 30;
+    auto fails_at = [&](const std::vector<uint8_t>& f, Status want, uint64_t at) {
+      const Loaded l = load(f, roomy);
+      CHECK_MESSAGE(l.status == want, keyanim::status_string(l.status) << " " << l.err.section << ": " << l.err.detail);
+      CHECK(l.err.byte_offset == at);
+      return l.err.detail;
+    };
     RawFile r = base;
     RawSection note;
     note.tag = "NOTE";
@@ -415,17 +424,35 @@ TEST_CASE("crafted counts beyond what the file's size can hold") {
     const size_t entry = 24 + 24 * (r.sections.size() - 1);
     const uint64_t frame_most = 32768 * uint64_t(note.stored.size());
     REQUIRE(note.raw_size > frame_most);
-    CHECK_FAILS(r.build(), Status::zstd_error, entry + 16);
-    CHECK(load(r.build()).err.detail.find("stored bytes can make") != std::string::npos);
+    CHECK(fails_at(r.build(), Status::zstd_error, entry + 16).find("stored bytes can make") != std::string::npos);
     r.sections.back().raw_size = frame_most + 1;  // one byte beyond the bound
-    CHECK_FAILS(r.build(), Status::zstd_error, entry + 16);
+    fails_at(r.build(), Status::zstd_error, entry + 16);
     r.sections.back().raw_size = frame_most;  // at it: the frame's blocks then refuse it
-    CHECK(load(r.build()).err.section == std::string("NOTE"));
+    CHECK(load(r.build(), roomy).err.section == std::string("NOTE"));
     // The same NOTE declared as what its frame makes loads.
     r.sections.back().raw_size = 64 << 10;
     const Loaded l = load(r.build());
     REQUIRE(l.status == Status::ok);
     CHECK(l.clip.encoder_notes() == std::string(64 << 10, 'a'));
+  }
+  {
+    // A valid NOTE of 600 MiB from 19 KB of RLE blocks, within the bound: the note limit
+    // (16 MiB by default) refuses it from the table; one of 16 MiB loads.
+    RawFile r = base;
+    RawSection note;
+    note.tag = "NOTE";
+    note.flags = 3;
+    note.stored = zstd_rle_frame(600ull << 20, 'a');
+    note.raw_size = 600ull << 20;
+    r.sections.push_back(note);
+    REQUIRE(r.build().size() < 20000);
+    CHECK_FAILS(r.build(), Status::limit_exceeded, 24 + 24 * (r.sections.size() - 1) + 16);
+    CHECK(load(r.build()).err.detail.find("NOTE declares 629145600 bytes, above the limit of 16777216") != std::string::npos);
+    r.sections.back().stored = zstd_rle_frame(16ull << 20, 'a');
+    r.sections.back().raw_size = 16ull << 20;
+    const Loaded l = load(r.build());
+    REQUIRE(l.status == Status::ok);
+    CHECK(l.clip.encoder_notes().size() == (16u << 20));
   }
 }
 

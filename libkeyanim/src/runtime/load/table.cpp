@@ -114,6 +114,10 @@ Status Loader::read_header_and_table() {
     if (e.raw > limits_.max_decompressed_bytes - raw_total || e.raw > limits_.max_decompressed_bytes)
       return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
                   "decompressed sections exceed the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
+    if (e.tag == internal::kTagNote && e.raw > limits_.max_note_bytes)
+      return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
+                  "NOTE declares " + std::to_string(e.raw) + " bytes, above the limit of " +
+                      std::to_string(limits_.max_note_bytes) + " (notes are informative text)");
     raw_total += e.raw;
   }
   if (Status s = check_expansion(); s != Status::ok) return s;

@@ -26,7 +26,7 @@ export const MAX_KEYS_PER_FILE_BYTE = MAX_ZSTD_EXPANSION;
 
 // keyanim's defaults (spec section 8).
 export const DEFAULT_LIMITS = Object.freeze({
-  nodes: 65536, channels: 262144, frames: 2 ** 24, keys: 268435456, rawBytes: 2 ** 30,
+  nodes: 65536, channels: 262144, frames: 2 ** 24, keys: 268435456, rawBytes: 2 ** 30, noteBytes: 2 ** 24,
 });
 
 // True when the bytes start like a .kanim file (the signature), for telling it from a BVH.
@@ -86,6 +86,7 @@ function readContainer(bytes, limits) {
   for (const s of sections) {
     if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
     if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `the sections decode to ${raw} bytes or more, above the limit of ${limits.rawBytes}`);
+    if (s.tag === 'NOTE' && s.rawSize > BigInt(limits.noteBytes ?? DEFAULT_LIMITS.noteBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `NOTE declares ${s.rawSize} bytes, above the limit of ${limits.noteBytes ?? DEFAULT_LIMITS.noteBytes} (notes are informative text)`);
   }
   sections.forEach((s, i) => {
     if (SECTION_PARSERS[s.tag] && s.compressed && s.rawSize > BigInt(MAX_ZSTD_EXPANSION) * s.storedSize)
