@@ -53,7 +53,8 @@ void check_key_times(size_t count, const std::function<double(size_t)>& time,
   }
 }
 
-// The frame window of the options; throws Error (invalid_argument) for options that make no sense.
+// The frame window of the options; throws Error (invalid_argument) for options that make no
+// sense, and (limit) for frame times glTF cannot hold (check_key_times).
 Window check_options(const Clip& clip, const GltfOptions& o) {
   if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) invalid("fps must be positive and finite");
   if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
