@@ -17,6 +17,7 @@
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::python {
 namespace {
@@ -55,13 +56,13 @@ void write_bvh_file(const offline::Motion& motion, const std::string& path, bool
   // BVH text holds finite numbers only: nan or inf (set through `channels`) would write a file
   // that no reader takes back.
   if (!std::isfinite(motion.frame_time) || motion.frame_time < 0.0)
-    throw offline::Error(offline::ErrorKind::invalid_argument, "the frame time is " + std::to_string(motion.frame_time) +
+    throw offline::Error(offline::ErrorKind::invalid_argument, "the frame time is " + offline::general_text(motion.frame_time) +
                                                                    ": BVH text cannot hold it", path);
   for (size_t i = 0; i < motion.values.size(); ++i)
     if (!std::isfinite(motion.values[i]))
       throw offline::Error(offline::ErrorKind::invalid_argument,
                            "channel " + std::to_string(i % motion.channel_count()) + " of frame " +
-                               std::to_string(i / motion.channel_count()) + " is " + std::to_string(motion.values[i]) +
+                               std::to_string(i / motion.channel_count()) + " is " + offline::general_text(motion.values[i]) +
                                ": BVH text holds finite numbers only",
                            path);
   int fd = offline::open_in_place(path);

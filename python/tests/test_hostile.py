@@ -2,6 +2,7 @@
 of failure: outputs that destroy something, reads that never end, buffers that crash."""
 
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -143,6 +144,15 @@ def test_dataset_takes_numpy_integers(keyanim):
 
 
 # Class 7: errors that say what happened.
+def test_encode_names_a_value_keys_cannot_hold_and_what_it_is(keyanim):
+    m = keyanim.read_bvh(WALK)
+    for value, said in ((float("nan"), r"is NaN \(not a number\)"), (float("-inf"), "is -inf"),
+                        (3e38, r"is 3e\+38, beyond what binary32 keys can hold")):
+        m.channels[3, 7] = value
+        with pytest.raises(keyanim.Error, match=r"^channel 7 \(\S+ [XYZ](position|rotation)\) of frame 3 " + said):
+            keyanim.encode(m)
+
+
 def test_encode_settings_out_of_range_say_so(keyanim, walk):
     with pytest.raises(keyanim.Error, match="level is out of range"):
         keyanim.encode(walk, level=2 ** 40)
@@ -150,3 +160,113 @@ def test_encode_settings_out_of_range_say_so(keyanim, walk):
         keyanim.encode(walk, level=True)
     with pytest.raises(keyanim.Error, match="threads is out of range"):
         keyanim.encode(walk, threads=-2 ** 63 - 1)
+
+
+# Class 6: the bytes of a .kanim do not depend on the process's locale.
+def comma_locale(tmp_path):
+    """(name, extra environment) of a locale whose decimal point is a comma: an installed one
+    (`locale -a`), else de_DE.UTF-8 compiled by localedef into tmp_path (glibc finds it through
+    LOCPATH), so that no system locale needs to be installed. None when neither can be had."""
+    probe = "import locale, sys; locale.setlocale(locale.LC_ALL, sys.argv[1]); print(locale.localeconv()['decimal_point'])"
+    def decimal_point(name, env):
+        r = subprocess.run([sys.executable, "-c", probe, name], capture_output=True, text=True, env=env)
+        return r.stdout.strip() if r.returncode == 0 else None
+    listed = subprocess.run(["locale", "-a"], capture_output=True, text=True).stdout.split() if shutil.which("locale") else []
+    for name in sorted(listed, key=lambda n: not n.startswith("de_DE")):
+        if is_utf8(name) and decimal_point(name, dict(os.environ)) == ",":
+            return name, {}
+    if shutil.which("localedef"):
+        subprocess.run(["localedef", "-i", "de_DE", "-f", "UTF-8", str(tmp_path / "de_DE.UTF-8")], capture_output=True)
+        env = dict(os.environ, LOCPATH=str(tmp_path))
+        if decimal_point("de_DE.UTF-8", env) == ",":
+            return "de_DE.UTF-8", {"LOCPATH": str(tmp_path)}
+    return None
+
+
+def is_utf8(name):
+    return name.lower().replace("-", "").endswith(".utf8")
+
+
+def test_encode_writes_the_same_bytes_under_a_comma_decimal_locale(keyanim, tmp_path):
+    found = comma_locale(tmp_path)
+    if found is None:
+        pytest.skip("no comma-decimal locale: none installed (locale -a) and localedef could not compile "
+                    "de_DE.UTF-8 (Debian: apt-get install locales)")
+    name, extra = found
+    code = ("import locale, sys, keyanim\n"
+            "if sys.argv[1] != 'C': locale.setlocale(locale.LC_ALL, sys.argv[1])\n"
+            "assert locale.localeconv()['decimal_point'] == ('.' if sys.argv[1] == 'C' else ',')\n"
+            "data, report = keyanim.encode(keyanim.read_bvh(sys.argv[2]), error=0.25, tension=0.5, shell=1.5, threads=1)\n"
+            "open(sys.argv[3], 'wb').write(data)\n")
+    env = module_env()
+    env.update(extra)
+    outputs = {}
+    for loc in ("C", name):
+        out = tmp_path / ("%s.kanim" % loc)
+        subprocess.run([sys.executable, "-c", code, loc, str(WALK), str(out)], check=True, env=env)
+        outputs[loc] = out.read_bytes()
+    notes = keyanim.Clip(outputs[name]).encoder_notes
+    assert "tension=0.500000\n" in notes and "tolerance=0.25\n" in notes and "shell=1.5\n" in notes, notes
+    assert outputs[name] == outputs["C"], "the notes under %s: %r" % (name, notes)
+
+
+# Class 3: counts beyond what the file's size can hold are refused as they are read (spec
+# section 8: a zstd frame makes at most 32768 bytes of each of its bytes, a key takes a byte of
+# KTIM at least), and so is a NOTE above the note limit, through the C++ loader: small files,
+# in a bounded interpreter.
+def crafted_kanim(frames, channels, key_count, note=None):
+    """A 3.0 file made here from spec/FORMAT.md (not by keyanim's writer): one node with
+    `channels` channels and no keys, CLIP declaring `key_count`, and optionally a compressed
+    NOTE given as (stored frame, Raw_Size)."""
+    import struct
+    import zlib
+    skel = struct.pack("<I", 1) + b"r" + struct.pack("<i3dBB", -1, 0, 0, 0, 0, channels) + bytes(range(channels))
+    clip = struct.pack("<IIIBBHdQ", frames, 1, channels, 0, 0, 0, 1 / 30, key_count)
+    chan = bytes(channels) + struct.pack("<%df" % channels, *[0.0] * channels) + \
+        struct.pack("<%dd" % channels, *[0.01] * channels) + bytes(4 * channels) + bytes(2 * channels)
+    sections = [(b"CLIP", 0, clip, 32), (b"SKEL", 0, skel, len(skel)), (b"CHAN", 0, chan, len(chan)),
+                (b"KTIM", 0, b"", 0), (b"KVAL", 0, b"", 0)]
+    if note:
+        sections.append((b"NOTE", 3, note[0], note[1]))
+    f = b"\x89KAN\r\n\x1a\n" + struct.pack("<HHIII", 3, 0, 0, len(sections), 0)
+    f += b"".join(tag + struct.pack("<IQQ", flags, len(stored), raw) for tag, flags, stored, raw in sections)
+    f += b"".join(s[2] for s in sections)
+    return f + struct.pack("<I", zlib.crc32(f))
+
+
+def rle_frame(size, byte):
+    """A zstd frame of `size` bytes of `byte` in RLE blocks of 128 KiB (4 bytes each)."""
+    import struct
+    out, left = bytearray(b"\x28\xb5\x2f\xfd\xe0" + struct.pack("<Q", size)), size
+    while True:
+        n = min(left, 1 << 17)
+        left -= n
+        out += struct.pack("<I", (n << 3) | 2 | (left == 0))[:3] + bytes([byte])
+        if left == 0:
+            return bytes(out)
+
+
+def test_counts_beyond_the_file_size_and_large_notes_are_refused_as_read(keyanim, tmp_path):
+    ok = crafted_kanim(1 << 24, 6, 0)
+    assert keyanim.Clip(ok).total_keys == 0  # the crafting is right
+    path = tmp_path / "keys.kanim"
+    path.write_bytes(crafted_kanim(1 << 24, 6, 1 << 28))
+    note = tmp_path / "note.kanim"  # a valid 600 MiB NOTE from 19 KB of RLE blocks: above the note limit
+    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(600 << 20, ord("a")), 600 << 20)))
+    assert path.stat().st_size < 1000 and note.stat().st_size < 20000
+    code = ("import keyanim, sys\n"
+            "for name in sys.argv[1:]:\n"
+            "    try:\n"
+            "        keyanim.Clip(name)\n"
+            "    except keyanim.Error as e:\n"
+            "        print(e)\n")
+    script = "import resource; resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))\n" + code
+    r = subprocess.run([sys.executable, "-c", script, str(path), str(note)], capture_output=True, text=True,
+                       timeout=20, env=module_env())
+    assert r.returncode == 0, r.stderr
+    keys, notes = r.stdout.splitlines()
+    assert "Key_Count 268435456 is more than a file of %d bytes can hold" % path.stat().st_size in keys
+    assert "NOTE declares 629145600 bytes, above the limit of 16777216" in notes
+    # The NOTE declared as what its frame makes loads.
+    note.write_bytes(crafted_kanim(2, 6, 0, note=(rle_frame(64 << 10, ord("a")), 64 << 10)))
+    assert keyanim.Clip(str(note)).encoder_notes == "a" * (64 << 10)

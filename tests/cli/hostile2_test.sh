@@ -9,7 +9,8 @@
 #   endless     reads that never end: FIFOs and /dev/zero where a command reads back
 #   report_names  a name that is not UTF-8 in a report keeps its line (and its bytes)
 #   wrong_results --shard with a huge N, two --skip-existing runs at once, an infinite frame time
-#   messages    errors that say what happened: tiny tolerances, an unreachable tolerance
+#   messages    errors that say what happened: tiny tolerances, an unreachable tolerance, a value
+#               keys cannot hold, frame times glTF's float32 seconds cannot hold
 #   proportion  work in proportion to the input: a small BVH without channels declaring 2^24
 #               frames (every frame is the rest pose: one frame is measured for all)
 set -uo pipefail
@@ -215,6 +216,28 @@ messages)
   expect_rc 6 "$K" encode "$WALK" -o tiny.kanim --error 1e-30
   grep -q 'could not reach the tolerance' "$T/.stderr" || die "encode --error 1e-30: $(cat "$T/.stderr")"
   [ ! -e tiny.kanim ] || die "a failed encode left an output"
+  # A value binary32 keys cannot hold is named (channel, joint, frame) with what it is.
+  printf 'HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\nMOTION\nFrames: 2\nFrame Time: 0.04\n0 0 0\n0 1e38 0\n' > big.bvh
+  expect_rc 2 "$K" encode big.bvh -o big.kanim
+  grep -q 'big.bvh: channel 1 (Hips Yposition) of frame 1 is 1e+38, beyond what binary32 keys can hold' "$T/.stderr" ||
+    die "a value of 1e38: $(cat "$T/.stderr")"
+  sed 's/1e38/nan/' big.bvh > nan.bvh  # the reader refuses it where it stands
+  expect_rc 2 "$K" encode nan.bvh -o nan.kanim
+  grep -q "nan.bvh:15:3: expected a finite number, found 'nan'" "$T/.stderr" || die "a NaN value: $(cat "$T/.stderr")"
+  # glTF's key times are float32 seconds: a frame time they cannot hold is said as the cause, not
+  # as a tolerance that cannot be held (with an error quoted below it).
+  sed 's/^Frame Time:.*/Frame Time: 1e308/' "$HOP" > huge.bvh
+  sed 's/^Frame Time:.*/Frame Time: 1e-50/' "$HOP" > tiny.bvh
+  "$K" -q encode huge.bvh -o huge.kanim && "$K" -q encode tiny.bvh -o tiny.kanim || die "encode the frame times"
+  expect_rc 1 "$K" decode huge.kanim -o huge.glb
+  grep -q 'huge.kanim: glTF export: glTF holds key times as float32 seconds: frame 1 is at 1e+308 s, beyond' "$T/.stderr" ||
+    die "glTF of a 1e308 s frame time: $(cat "$T/.stderr")"
+  expect_rc 1 "$K" decode tiny.kanim -o tiny.glb
+  grep -q 'frame 0 and frame 1 (at 0 and 1e-50 s) are the same float32 time' "$T/.stderr" ||
+    die "glTF of a 1e-50 s frame time: $(cat "$T/.stderr")"
+  ! grep -q 'cannot hold the tolerance' "$T/.stderr" || die "the tolerance blamed: $(cat "$T/.stderr")"
+  [ ! -e huge.glb ] && [ ! -e tiny.glb ] || die "a refused export left an output"
+  expect_rc 0 "$K" decode huge.kanim --frames 5:5 -o one.glb  # one frame has one time: it fits
   ;;
 proportion)
   # 151 joints in a chain, no channels, Frames: 16777216: 121 KB of text. Every frame is the

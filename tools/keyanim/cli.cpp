@@ -14,6 +14,7 @@
 #include "keyanim/offline/bvh.h"
 #include "progress.h"
 #include "suggest.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -128,10 +129,9 @@ uint64_t parse_size(const std::string& option, const std::string& text) {
 void check_values(uint64_t frames, uint64_t channels, const std::string& what, const Globals& g) {
   const uint64_t per_frame = std::max<uint64_t>(channels, 1);
   if (frames <= g.limits.max_values / per_frame) return;
-  const long double values = static_cast<long double>(frames) * per_frame;
-  char text[160];
-  std::snprintf(text, sizeof text, "%.4Lg values (%llu frames x %llu channels)", values,
-                static_cast<unsigned long long>(frames), static_cast<unsigned long long>(channels));
+  const double values = double(frames) * double(per_frame);  // 4 digits shown: double is exact enough
+  const std::string text = offline::general_text(values, 4) + " values (" + std::to_string(frames) + " frames x " +
+                           std::to_string(channels) + " channels)";
   fail(kLimit, what + " would make " + text + ", over the limit of " + std::to_string(g.limits.max_values) +
                    " (raise it with --max-values N)");
 }

@@ -10,6 +10,7 @@
 #include "progress.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/decode.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -88,7 +89,7 @@ int cmd_decode(const Argv& argv, Globals& g) {
   output.commit();
   bar.erase();
   if (g.verbosity > 0 && out != "-")
-    std::cerr << printable(in + " -> " + out) << ": " << count_of(decoder.frame_count(), "frame") << " at " << decoder.frame_time() << " s\n";
+    std::cerr << printable(in + " -> " + out) << ": " << count_of(decoder.frame_count(), "frame") << " at " << offline::general_text(decoder.frame_time()) << " s\n";
   return kOk;
 }
 

@@ -17,6 +17,7 @@
 #include "keyanim/offline/report.h"
 #include "settings.h"
 #include "tally.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -89,15 +90,16 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
 namespace {
 
 std::string human_line(const nlohmann::json& j) {
+  auto g = [](const nlohmann::json& v) { return offline::general_text(v.get<double>()); };  // as a stream's %g
   std::ostringstream line;
   line << j["input"].get<std::string>() << " -> " << j["output"].get<std::string>() << ": " << j["kanim_bytes"]
-       << " bytes, " << j["ratio_raw_f32"].get<double>() << "x raw float32, " << j["keys"] << " keys; error max "
-       << j["error"]["max"].get<double>() << " (" << j["error"]["worst_point"].get<std::string>() << ", frame "
+       << " bytes, " << g(j["ratio_raw_f32"]) << "x raw float32, " << j["keys"] << " keys; error max "
+       << g(j["error"]["max"]) << " (" << j["error"]["worst_point"].get<std::string>() << ", frame "
        << j["error"]["worst_frame"];
   if (j["error"].contains("worst_reading")) line << ", " << j["error"]["worst_reading"].get<std::string>() << " reading";
   line << ")";
-  if (j.contains("tolerance")) line << ", tolerance " << j["tolerance"].get<double>();
-  line << ", shell " << j["error"]["shell"].get<double>();
+  if (j.contains("tolerance")) line << ", tolerance " << g(j["tolerance"]);
+  line << ", shell " << g(j["error"]["shell"]);
   return printable(line.str());
 }
 

@@ -23,6 +23,7 @@
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -161,8 +162,9 @@ nlohmann::json acl_summary(const std::vector<nlohmann::json>& files) {
 void print_acl_summary(const nlohmann::json& summary) {
   for (const auto& [run, groups] : summary.items())
     for (const auto& [group, g] : groups.items())
-      std::printf("against ACL, %s, %s: %zu files, median %.3f, worst %.3f (%s)\n", run.c_str(), group.c_str(),
-                  g["files"].get<size_t>(), g["median_ratio"].get<double>(), g["worst_ratio"].get<double>(),
+      std::printf("against ACL, %s, %s: %zu files, median %s, worst %s (%s)\n", run.c_str(), group.c_str(),
+                  g["files"].get<size_t>(), offline::fixed_text(g["median_ratio"].get<double>(), 3).c_str(),
+                  offline::fixed_text(g["worst_ratio"].get<double>(), 3).c_str(),
                   printable(g["worst_file"].get<std::string>()).c_str());
 }
 

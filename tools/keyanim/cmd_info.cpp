@@ -7,6 +7,7 @@
 #include "escape.h"
 #include "io.h"
 #include "keyanim/offline/report.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -21,9 +22,7 @@ const char* const kInfoHelp =
 namespace {
 
 std::string number(double v, int digits) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*g", digits, v);
-  return text;
+  return offline::general_text(v, digits);
 }
 
 // The encoder's notes as an indented block, a line each (none for an empty line).

@@ -18,6 +18,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -175,7 +176,7 @@ int cmd_render(const Argv& argv, Globals& g) {
   if (g.verbosity > 0) {
     std::cerr << printable(in + " -> " + out) << ": frame " << frame;
     if (series.size() == 2)
-      std::cerr << ", largest distance " << fig.worst_distance << " ("
+      std::cerr << ", largest distance " << offline::general_text(fig.worst_distance) << " ("
                 << printable(offline::node_name(first.skeleton, fig.worst_node)) << ")";
     std::cerr << "\n";
     // What the file leaves open, when render chose it.

@@ -8,6 +8,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/report.h"
 #include "suggest.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 
@@ -32,14 +33,9 @@ namespace {
 void check_position(const std::string& in, const Clip& clip, const char* option, double given, double pos) {
   const double last = double(clip.frame_count() - 1);
   if (pos >= 0.0 && (pos <= last || (option[2] == 't' && pos <= last * (1.0 + 1e-12)))) return;
-  char text[200];
-  if (option[2] == 'f')
-    std::snprintf(text, sizeof text, "%s %.9g is not in the clip (it has frames 0 to %u)", option, given,
-                  clip.frame_count() - 1);
-  else
-    std::snprintf(text, sizeof text, "%s %.9g is not in the clip (it has times 0 to %.9g s)", option, given,
-                  clip.duration());
-  fail(kUsage, in + ": " + text);
+  const std::string has = option[2] == 'f' ? "frames 0 to " + std::to_string(clip.frame_count() - 1)
+                                            : "times 0 to " + offline::general_text(clip.duration(), 9) + " s";
+  fail(kUsage, in + ": " + option + " " + offline::general_text(given, 9) + " is not in the clip (it has " + has + ")");
 }
 
 }  // namespace

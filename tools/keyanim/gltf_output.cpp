@@ -17,6 +17,7 @@
 #include "progress.h"
 #include "keyanim/offline/report.h"
 #include "settings.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::cli {
 namespace {
@@ -123,11 +124,12 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   ": %zu bytes, %u nodes, %u translation tracks (%u keys), %u rotation tracks (%u LINEAR, "
-                  "%u CUBICSPLINE, %u keys); error max %.6g (%s, frame %u), tolerance %.6g\n",
+                  "%u CUBICSPLINE, %u keys); error max %s (%s, frame %u), tolerance %s\n",
                   asset.main.size() + asset.bin.size(), r.nodes, r.translation_tracks, r.translation_keys,
                   r.linear_rotation_tracks + r.cubic_rotation_tracks, r.linear_rotation_tracks, r.cubic_rotation_tracks,
-                  r.rotation_keys, r.max_error, printable(offline::point_name(clip.skeleton(), r.worst_node, uint32_t(r.worst_axis + 1))).c_str(), r.worst_frame,
-                  r.tolerance);
+                  r.rotation_keys, offline::general_text(r.max_error).c_str(),
+                  printable(offline::point_name(clip.skeleton(), r.worst_node, uint32_t(r.worst_axis + 1))).c_str(),
+                  r.worst_frame, offline::general_text(r.tolerance).c_str());
     std::cerr << printable(in + " -> " + out) << buf;
   }
   const std::string warning = resampled_warning(clip, o, r);

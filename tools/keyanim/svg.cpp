@@ -5,14 +5,13 @@
 #include <cstdio>
 
 #include "escape.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::svg {
 
 std::string number(double v, int decimals) {
   if (!std::isfinite(v)) return "0";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 12), v);
-  std::string s = buf;
+  std::string s = offline::fixed_text(v, std::clamp(decimals, 0, 12));
   if (s.find('.') != std::string::npos) {
     while (s.back() == '0') s.pop_back();
     if (s.back() == '.') s.pop_back();

@@ -101,6 +101,15 @@ const cases = {
   'Frame_Time 0 with 20 frames': content('CLIP', (b) => dv(b).setFloat64(16, 0, true)),
   'Key_Count above C x F': content('CLIP', (b) => dv(b).setBigUint64(24, 241n, true)),
   'Key_Count above limit': content('CLIP', (b) => dv(b).setBigUint64(24, 2n ** 40n, true)),
+  // Spec section 8: at most 32768 keys a byte of the file (v3_rules: 522 bytes), refused as
+  // CLIP is read; at the bound the rule lets the file through to CHAN's disagreeing key counts.
+  'Key_Count beyond what the file can hold': content('CLIP', (b) => { dv(b).setUint32(0, 2 ** 24, true); dv(b).setBigUint64(24, 2n ** 27n, true); }),
+  'Key_Count at what the file can hold': content('CLIP', (b) => { dv(b).setUint32(0, 2 ** 24, true); dv(b).setBigUint64(24, 32768n * BigInt(read('v3_rules.kanim').length), true); }),
+  // A compressed section declaring more than 32768 bytes for each stored one: refused from the table.
+  'Raw_Size beyond what its frame can make': edit('v3_rules.kanim', (m) => { const f = zstdRawFrame(m.sections[1].content); m.sections[1].flags |= 1; m.sections[1].stored = f; m.sections[1].rawSize = 32768 * f.length + 1; }),
+  // A NOTE above the note limit (16 MiB): refused from the table, before its frame is looked at.
+  'NOTE above its limit': edit('v3_long.kanim', (m) => { section(m, 'NOTE').rawSize = 2 ** 24 + 1; }),
+  'Raw_Size at what its frame can make': edit('v3_rules.kanim', (m) => { const f = zstdRawFrame(m.sections[1].content); m.sections[1].flags |= 1; m.sections[1].stored = f; m.sections[1].rawSize = 32768 * f.length; }),
   'Key_Count differs from CHAN': content('CLIP', (b) => dv(b).setBigUint64(24, 54n, true)),
   'Channel_Count differs from SKEL': content('CLIP', (b) => dv(b).setUint32(8, 13, true)),
   'Node_Count one less': content('CLIP', (b) => dv(b).setUint32(4, 4, true)),

@@ -30,6 +30,10 @@ struct DecodeLimits {
   uint32_t max_frames = 1u << 24;             // Defaults to 16777216 frames, which is also the most any clip may have.
   uint64_t max_keys = 1ull << 28;             // Defaults to 268435456 keys in all.
   uint64_t max_decompressed_bytes = 1ull << 30;  // Defaults to 1 GiB of decompressed sections.
+  // Defaults to 16 MiB of NOTE. Notes are informative text (keyanim writes some 400 bytes), and
+  // a frame of RLE blocks makes 32768 bytes of each of its own: a 19 KB file may hold a 600 MiB
+  // note, which this refuses from the section table.
+  uint64_t max_note_bytes = 16ull << 20;
 };
 
 // What a channel is, independent of how a loaded clip stores it.

@@ -53,4 +53,14 @@ inline constexpr uint32_t kMaxVarint64Bytes = 10;
 
 inline constexpr uint32_t kZstdMagic = 0xFD2FB528u;
 
+// Spec section 8, limits that follow from the file's size. No zstd frame makes more than 32768
+// bytes of each of its bytes: a block produces at most 128 KiB, and the cheapest, an RLE block,
+// takes 4 bytes (3 of header, 1 repeated); a Compressed block producing as much takes more, the
+// frame header more still. An uncompressed section is its own size. So a valid file of N bytes
+// has at most 32768 N bytes of sections, and (a key taking at least one byte of KTIM's content,
+// its varint) at most 32768 N keys. Checked on the counts before anything they size, with the
+// status the file would fail with later (zstd_error, corrupt): the refusal is only earlier.
+inline constexpr uint64_t kMaxZstdExpansion = 32768;
+inline constexpr uint64_t kMaxKeysPerFileByte = kMaxZstdExpansion;
+
 }  // namespace keyanim::internal

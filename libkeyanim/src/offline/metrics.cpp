@@ -8,6 +8,7 @@
 
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/fk.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::offline {
 namespace {
@@ -193,7 +194,7 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded, double 
     throw Error(ErrorKind::invalid_argument, "a motion's values do not fill frames x channels, or its channel "
                                              "columns lie outside a frame");
   if (!(shell >= 0.0 && std::isfinite(shell)))
-    throw Error(ErrorKind::invalid_argument, "the shell distance must be 0 or more and finite, got " + std::to_string(shell));
+    throw Error(ErrorKind::invalid_argument, "the shell distance must be 0 or more and finite, got " + general_text(shell));
   // Without channels every frame of both is the rest pose: frame 0 stands for all (and the
   // work follows the input, not a declared frame count).
   const uint32_t measured = channels == 0 ? std::min<uint32_t>(frames, 1) : frames;

@@ -374,6 +374,88 @@ TEST_CASE("crafted zstd frames") {
   }
 }
 
+// Spec section 8, limits that follow from the file's size: no zstd frame makes more than 32768
+// bytes of each of its bytes, and a key takes a byte of KTIM at least, so a file of N bytes
+// holds at most 32768 N keys, and a section at most 32768 times its stored bytes. A count
+// beyond is refused where it is read (CLIP's Key_Count, the table's Raw_Size), before any
+// section is inflated or anything it sizes allocated, with the status a later step would give
+// (corrupt, zstd_error): the files here are a few hundred bytes.
+TEST_CASE("crafted counts beyond what the file's size can hold") {
+  const RawFile base = base_file();
+  const size_t n = base.build().size();
+  uint32_t channels = 0;
+  std::memcpy(&channels, base.sections[0].stored.data() + 8, 4);
+  auto with_keys = [&](uint64_t keys) {
+    RawFile r = base;
+    poke(r.sections[0].stored, 0, uint32_t(1) << 24);  // Frame_Count 2^24: C x F allows the keys
+    poke(r.sections[0].stored, 24, keys);
+    return r.build();
+  };
+  const uint64_t most = 32768 * uint64_t(n);
+  const uint64_t cf = uint64_t(channels) << 24;
+  REQUIRE(cf > most);  // within Channel_Count x Frame_Count and the default limits
+  REQUIRE(most + 1 <= keyanim::DecodeLimits{}.max_keys);
+  CHECK_FAILS(with_keys(most + 1), Status::corrupt, base.offset_of("CLIP") + 24);
+  CHECK(load(with_keys(most + 1)).err.detail.find("more than a file of " + std::to_string(n) + " bytes can hold") !=
+        std::string::npos);
+  CHECK_FAILS(with_keys(cf), Status::corrupt, base.offset_of("CLIP") + 24);
+  // At the bound the rule lets the file through (CHAN's key counts then disagree with CLIP's).
+  CHECK(load(with_keys(most)).status == Status::corrupt);
+  CHECK(load(with_keys(most)).err.section == std::string("CHAN"));
+  {
+    // A NOTE declaring 1 GiB - 1 MiB behind a frame of 64 KiB (a few bytes): refused at the
+    // table (before, once its frame's blocks were walked). The note limit is raised here, so
+    // that the bound is what refuses it.
+    keyanim::DecodeLimits roomy;
+    roomy.max_note_bytes = 1ull << 30;
+    auto fails_at = [&](const std::vector<uint8_t>& f, Status want, uint64_t at) {
+      const Loaded l = load(f, roomy);
+      CHECK_MESSAGE(l.status == want, keyanim::status_string(l.status) << " " << l.err.section << ": " << l.err.detail);
+      CHECK(l.err.byte_offset == at);
+      return l.err.detail;
+    };
+    RawFile r = base;
+    RawSection note;
+    note.tag = "NOTE";
+    note.flags = 3;  // compressed, ancillary
+    note.stored = zstd_rle_frame(64 << 10, 'a');
+    note.raw_size = (1ull << 30) - (1ull << 20);
+    r.sections.push_back(note);
+    const size_t entry = 24 + 24 * (r.sections.size() - 1);
+    const uint64_t frame_most = 32768 * uint64_t(note.stored.size());
+    REQUIRE(note.raw_size > frame_most);
+    CHECK(fails_at(r.build(), Status::zstd_error, entry + 16).find("stored bytes can make") != std::string::npos);
+    r.sections.back().raw_size = frame_most + 1;  // one byte beyond the bound
+    fails_at(r.build(), Status::zstd_error, entry + 16);
+    r.sections.back().raw_size = frame_most;  // at it: the frame's blocks then refuse it
+    CHECK(load(r.build(), roomy).err.section == std::string("NOTE"));
+    // The same NOTE declared as what its frame makes loads.
+    r.sections.back().raw_size = 64 << 10;
+    const Loaded l = load(r.build());
+    REQUIRE(l.status == Status::ok);
+    CHECK(l.clip.encoder_notes() == std::string(64 << 10, 'a'));
+  }
+  {
+    // A valid NOTE of 600 MiB from 19 KB of RLE blocks, within the bound: the note limit
+    // (16 MiB by default) refuses it from the table; one of 16 MiB loads.
+    RawFile r = base;
+    RawSection note;
+    note.tag = "NOTE";
+    note.flags = 3;
+    note.stored = zstd_rle_frame(600ull << 20, 'a');
+    note.raw_size = 600ull << 20;
+    r.sections.push_back(note);
+    REQUIRE(r.build().size() < 20000);
+    CHECK_FAILS(r.build(), Status::limit_exceeded, 24 + 24 * (r.sections.size() - 1) + 16);
+    CHECK(load(r.build()).err.detail.find("NOTE declares 629145600 bytes, above the limit of 16777216") != std::string::npos);
+    r.sections.back().stored = zstd_rle_frame(16ull << 20, 'a');
+    r.sections.back().raw_size = 16ull << 20;
+    const Loaded l = load(r.build());
+    REQUIRE(l.status == Status::ok);
+    CHECK(l.clip.encoder_notes().size() == (16u << 20));
+  }
+}
+
 TEST_CASE("load_file reports I/O errors") {
   Clip c;
   ErrorInfo err;

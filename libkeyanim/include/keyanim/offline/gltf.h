@@ -91,9 +91,10 @@ struct GltfOutput {
 // Builds the asset. Throws Error: invalid_argument for options that make no sense (tolerance or
 // fps not positive and finite, shell_percent not finite, an empty or reversed frame range,
 // last_frame beyond the clip, a tolerance of 0 for a skeleton without extent) and for a clip
-// whose frame time is not positive while it has several frames; limit for a tolerance that
-// float32 keys cannot hold, or a range too long for one asset (working memory above 1 GiB,
-// more than 2^24 resampled keys, 4 GiB of output).
+// whose frame time is not positive while it has several frames; limit for key times that
+// glTF's float32 seconds cannot hold (beyond 3.4e38 s, or two keys on one float32 time), a
+// tolerance that float32 keys cannot hold, or a range too long for one asset (working memory
+// above 1 GiB, more than 2^24 resampled keys, 4 GiB of output).
 GltfOutput export_gltf(const Clip& clip, const GltfOptions& options);
 
 }  // namespace keyanim::offline

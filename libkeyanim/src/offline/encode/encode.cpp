@@ -25,6 +25,7 @@
 #include "offline/encode/signals.h"
 #include "offline/encode/verify.h"
 #include "offline/parallel.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::offline {
 namespace {
@@ -205,7 +206,7 @@ uint32_t fit_within_tolerance(const Job& job) {
     if (job.settings.key_mode != KeyMode::error || m.frame_count == 0) return round + 1;
     if (!verify_and_tighten(job, round, budgets, marks)) return round + 1;
     if (round + 1 >= kMaxRounds)
-      throw Error(ErrorKind::limit, "could not reach the tolerance of " + std::to_string(job.tol_units) +
+      throw Error(ErrorKind::limit, "could not reach the tolerance of " + general_text(job.tol_units) +
                                         " units after " + std::to_string(kMaxRounds) +
                                         " rounds (below float32 precision?)");
   }

@@ -3,44 +3,36 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <sstream>
 
+#include "keyanim/offline/number_text.h"
 #include "keyanim/version.h"
 
 namespace keyanim::offline {
 
-namespace {
-
-// The shortest text that reads back as the same double.
-std::string round_trip(double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
-}
-
-}  // namespace
-
 std::string encoder_notes(const EncodeSettings& s, double tol_units, const Skeleton& skeleton, const ErrorReport& e,
                           uint32_t rounds) {
-  std::ostringstream o;
+  // The same text as the stream and std::to_string of earlier versions wrote in the "C" locale
+  // (%g, and %f for the tension), in any locale: the bytes of a .kanim do not depend on it.
   static const char* kModes[] = {"error", "uniform", "manual", "curvature"};
   const char* reading = e.worst_reading == PositionReading::add ? "add" : "replace";
-  o << "encoder=keyanim " << KEYANIM_VERSION_STRING << "\n"
-    << "keys=" << kModes[int(s.key_mode)] << "\n"
-    << "tolerance=" << s.tolerance << (s.tolerance_in_percent ? "%" : "") << "\n"
-    << "tolerance_units=" << tol_units << "\n"
-    << "shell=" << s.shell << (s.shell_in_percent ? "%" : "") << "\n"
-    << "shell_units=" << round_trip(e.shell) << "\n"  // read back to measure as the encoder did
-    << "readings=" << (e.both_readings ? "replace,add" : "replace") << "\n"
-    << "tension=" << (s.fit_tension ? std::string("fit") : std::to_string(s.tension)) << "\n"
-    << "tangent_rule=" << (s.tangent_rule == TangentRule::step_adjusted ? "step_adjusted" : "uniform") << "\n"
-    << "max_error=" << e.max_error << "\n"
-    << "rms_error=" << e.rms_error << "\n"
-    << "worst_point=" << point_name(skeleton, e.worst_joint, e.worst_point) << "\n"
-    << "worst_frame=" << e.worst_frame << "\n";
-  if (e.both_readings) o << "worst_reading=" << reading << "\n";
-  o << "rounds=" << rounds << "\n";
-  return o.str();
+  std::string o;
+  auto line = [&o](const char* key, const std::string& value) { o.append(key).append("=").append(value).append("\n"); };
+  line("encoder", std::string("keyanim ") + KEYANIM_VERSION_STRING);
+  line("keys", kModes[int(s.key_mode)]);
+  line("tolerance", general_text(s.tolerance) + (s.tolerance_in_percent ? "%" : ""));
+  line("tolerance_units", general_text(tol_units));
+  line("shell", general_text(s.shell) + (s.shell_in_percent ? "%" : ""));
+  line("shell_units", shortest_text(e.shell));  // read back to measure as the encoder did
+  line("readings", e.both_readings ? "replace,add" : "replace");
+  line("tension", s.fit_tension ? std::string("fit") : fixed_text(s.tension, 6));
+  line("tangent_rule", s.tangent_rule == TangentRule::step_adjusted ? "step_adjusted" : "uniform");
+  line("max_error", general_text(e.max_error));
+  line("rms_error", general_text(e.rms_error));
+  line("worst_point", point_name(skeleton, e.worst_joint, e.worst_point));
+  line("worst_frame", std::to_string(e.worst_frame));
+  if (e.both_readings) line("worst_reading", reading);
+  line("rounds", std::to_string(rounds));
+  return o;
 }
 
 std::optional<std::string> note(const std::string& notes, std::string_view key) {

@@ -6,6 +6,7 @@
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
+#include "keyanim/offline/number_text.h"
 #include "offline/parallel.h"
 
 namespace keyanim::offline {
@@ -15,6 +16,23 @@ namespace {
 constexpr double kMaxMagnitude = 1e37;
 constexpr uint32_t kCheckWindow = 256;  // frames per FK job
 
+// Which value, and what is wrong with it: NaN and infinities (which a BVH reader refuses, with
+// its line and column, but a motion built in memory can hold) are not "too large".
+Error bad_value(const Motion& m, size_t i) {
+  const uint32_t n_ch = m.channel_count();
+  const uint32_t c = uint32_t(i % n_ch), f = uint32_t(i / n_ch);
+  std::string name = "channel " + std::to_string(c);
+  for (const Joint& j : m.skeleton.joints)
+    if (c >= j.first_channel && c - j.first_channel < j.channels.size())
+      name += " (" + j.name + " " + channel_name(j.channels[c - j.first_channel]) + ")";
+  const double v = m.values[i];
+  const std::string what = std::isnan(v)   ? "is NaN (not a number): a key cannot hold it"
+                           : std::isinf(v) ? std::string("is ") + (v > 0 ? "+" : "-") + "inf: a key cannot hold it"
+                                           : "is " + general_text(v, 9) +
+                                                 ", beyond what binary32 keys can hold (|v| > 1e37)";
+  return Error(ErrorKind::malformed, name + " of frame " + std::to_string(f) + " " + what);
+}
+
 }  // namespace
 
 void check_motion(const Motion& m, unsigned threads) {
@@ -22,9 +40,8 @@ void check_motion(const Motion& m, unsigned threads) {
   if (m.values.size() != size_t(n_ch) * m.frame_count)
     throw Error(ErrorKind::invalid_argument,
                 "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels");
-  for (double v : m.values)
-    if (!(std::fabs(v) <= kMaxMagnitude))
-      throw Error(ErrorKind::malformed, "a channel value is beyond what binary32 keys can hold (|v| > 1e37)");
+  for (size_t i = 0; i < m.values.size(); ++i)
+    if (!(std::fabs(m.values[i]) <= kMaxMagnitude)) throw bad_value(m, i);
   const size_t windows = (size_t(m.frame_count) + kCheckWindow - 1) / kCheckWindow;
   std::vector<uint8_t> overflow(windows, 0);
   parallel_for(windows, threads, [&](size_t w, unsigned) {

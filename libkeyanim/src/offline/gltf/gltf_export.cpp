@@ -1,6 +1,8 @@
 // export_gltf (keyanim/offline/gltf.h): options and the frame window, translations mapped,
 // rotations fitted or resampled, the result checked and written.
+#include <cfloat>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "gltf_curves.h"
@@ -12,6 +14,7 @@
 #include "keyanim/offline/gltf.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/notes.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::offline {
 namespace {
@@ -27,7 +30,31 @@ constexpr double kRoundingMargin = 1e-6;  // of the skeleton size
 
 [[noreturn]] void invalid(const std::string& why) { throw Error(ErrorKind::invalid_argument, why); }
 
-// The frame window of the options; throws Error (invalid_argument) for options that make no sense.
+// glTF key times are float32 seconds and must increase strictly (glTF 2.0, 3.11: an animation
+// sampler's input). A frame time too large overflows float32 (1e308 s: every frame after the
+// first at infinity), one too small rounds neighbours to one time; either is said as the cause
+// here, before a fit that could only fail for it. `time(i)` is key i's time in seconds and
+// `name` how a message calls key i ("frame 12", "key 3").
+void check_key_times(size_t count, const std::function<double(size_t)>& time,
+                     const std::function<std::string(size_t)>& name, double frame_time) {
+  const std::string source = " (the clip's frame time is " + general_text(frame_time, 9) + " s)";
+  float previous = 0.0f;
+  for (size_t i = 0; i < count; ++i) {
+    const double t = time(i);
+    const float f = float(t);
+    if (!std::isfinite(f))
+      throw Error(ErrorKind::limit, "glTF holds key times as float32 seconds: " + name(i) + " is at " + general_text(t) +
+                                        " s, beyond float32's largest, " + general_text(FLT_MAX) + source);
+    if (i > 0 && !(f > previous))
+      throw Error(ErrorKind::limit, "glTF holds key times as float32 seconds, which must increase: " + name(i - 1) +
+                                        " and " + name(i) + " (at " + general_text(time(i - 1), 9) + " and " +
+                                        general_text(t, 9) + " s) are the same float32 time" + source);
+    previous = f;
+  }
+}
+
+// The frame window of the options; throws Error (invalid_argument) for options that make no
+// sense, and (limit) for frame times glTF cannot hold (check_key_times).
 Window check_options(const Clip& clip, const GltfOptions& o) {
   if (!(o.fps >= 0.0) || !std::isfinite(o.fps)) invalid("fps must be positive and finite");
   if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance) || (o.tolerance_in_percent && o.tolerance > 100.0))
@@ -46,6 +73,10 @@ Window check_options(const Clip& clip, const GltfOptions& o) {
     invalid("frame range " + std::to_string(w.first) + ":" + std::to_string(w.last) + " is not within 0:" +
             std::to_string(frames - 1));
   if (w.last > w.first && !(w.frame_time > 0.0)) invalid("the clip's frame time is not positive");
+  if (o.fps == 0.0)  // the keys are the frames (with --fps, resample_positions checks its keys)
+    check_key_times(
+        w.frames(), [&](size_t i) { return w.time(w.first + uint32_t(i)); },
+        [&](size_t i) { return "frame " + std::to_string(w.first + i); }, w.frame_time);
   return w;
 }
 
@@ -68,6 +99,9 @@ void resample_positions(const Window& w, double fps, std::vector<double>& positi
     times.push_back(duration);
     positions.push_back(double(w.last));
   }
+  check_key_times(
+      times.size(), [&](size_t i) { return times[i]; }, [](size_t i) { return "key " + std::to_string(i); },
+      w.frame_time);
 }
 
 // What percentages are of, as the encoder measures it (encode.h's reference_size): a

@@ -7,6 +7,7 @@
 
 #include "gltf_player.h"
 #include "keyanim/offline/error.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::offline::gltf {
 namespace {
@@ -219,7 +220,8 @@ std::vector<bool> blame(const std::vector<Violation>& violations, const std::vec
 std::string describe_failure(const Skeleton& sk, const Reference& ref, const CheckResult& r, double tolerance) {
   std::ostringstream o;
   const uint32_t node = ref.owner(r.worst_point);
-  o << "float32 glTF keys cannot hold the tolerance " << tolerance << ": error " << r.max_error << " at "
+  o << "float32 glTF keys cannot hold the tolerance " << general_text(tolerance) << ": error "
+    << general_text(r.max_error) << " at "
     << (sk.joints[node].end_site ? "the End Site of " + sk.joints[sk.joints[node].parent].name : sk.joints[node].name)
     << (ref.moved_by_owner(r.worst_point) ? " (shell point)" : "") << ", frame "
     << ref.window().first + r.worst_frame_index << " (use a larger --error)";

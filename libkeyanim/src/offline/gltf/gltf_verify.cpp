@@ -64,7 +64,9 @@ CheckResult check_model(const Model& model, const Reference& reference, double t
       }
     }
     for (uint32_t p = 0; p < np; ++p) {
-      if (!(worst[p] <= result.max_error)) {
+      // NaN stays the worst once found: a later finite error must not replace it (the message
+      // would then quote an error below the tolerance it says cannot be held).
+      if (!std::isnan(result.max_error) && !(worst[p] <= result.max_error)) {
         result.max_error = worst[p];
         result.worst_point = p;
         result.worst_frame_index = i;

@@ -1,6 +1,7 @@
 #include "keyanim/offline/acl_compare.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -13,6 +14,17 @@ std::vector<std::string> fields(const std::string& line) {
   std::stringstream ss(line);
   for (std::string f; std::getline(ss, f, '\t');) out.push_back(f);
   return out;
+}
+
+// A number of the table, 0 when there is none. Not strtod: it follows the process's locale, and
+// under a comma-decimal one reads "0.5" as 0.
+double table_number(const std::string& text) {
+  const char* p = text.data();
+  const char* end = p + text.size();
+  while (p != end && (*p == ' ' || *p == '\t')) ++p;
+  if (p != end && *p == '+') ++p;
+  double v = 0.0;
+  return std::from_chars(p, end, v).ec == std::errc() ? v : 0.0;
 }
 
 double median(std::vector<double> v) {
@@ -46,11 +58,10 @@ std::map<std::string, AclFile> read_acl_table(const std::string& path, std::stri
     if (f.size() < head.size()) continue;
     AclFile& a = out[f[file]];
     a.group = f[group];
-    char* end = nullptr;
-    a.fps = std::strtod(f[fps].c_str(), &end);
-    const double b = std::strtod(f[bytes].c_str(), &end), e = std::strtod(f[err].c_str(), &end);
+    a.fps = table_number(f[fps]);
+    const double b = table_number(f[bytes]), e = table_number(f[err]);
     // A skeleton without extent has no shell and no threshold: no usable row (anchors README).
-    const bool sized = size >= head.size() || std::strtod(f[size].c_str(), &end) > 0.0;
+    const bool sized = size >= head.size() || table_number(f[size]) > 0.0;
     if (sized && e > 0.0 && b > 0.0 && std::isfinite(e) && std::isfinite(b)) a.rows.push_back({b, e});
   }
   for (auto& [name, a] : out) {

@@ -9,6 +9,7 @@
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/notes.h"
+#include "keyanim/offline/number_text.h"
 
 namespace keyanim::offline {
 
@@ -35,22 +36,19 @@ nlohmann::json error_json(const Skeleton& s, const offline::ErrorReport& e) {
 }
 
 std::string error_text(const Skeleton& s, const offline::ErrorReport& e) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, "max %.6g (%s, frame %u%s), rms %.3g", e.max_error,
-                offline::point_name(s, e.worst_joint, e.worst_point).c_str(), e.worst_frame,
-                !e.both_readings ? "" : e.worst_reading == PositionReading::add ? ", add reading" : ", replace reading",
-                e.rms_error);
-  return buf;
+  return "max " + offline::general_text(e.max_error) + " (" + offline::point_name(s, e.worst_joint, e.worst_point) +
+         ", frame " + std::to_string(e.worst_frame) +
+         (!e.both_readings ? "" : e.worst_reading == PositionReading::add ? ", add reading" : ", replace reading") +
+         "), rms " + offline::general_text(e.rms_error, 3);
 }
 std::string tolerance_warning(const offline::EncodeSettings& s, double tolerance_units, double max_error) {
   if (s.key_mode == offline::KeyMode::error || max_error <= tolerance_units) return {};
   const std::string mode = s.key_mode == offline::KeyMode::uniform ? "uniform:" + std::to_string(s.uniform_interval)
                            : s.key_mode == offline::KeyMode::manual  ? "manual"
                                                                      : "curvature";
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "error max %.6g exceeds --error %.6g%s (%.6g units), which --keys %s does not enforce",
-                max_error, s.tolerance, s.tolerance_in_percent ? "%" : "", tolerance_units, mode.c_str());
-  return buf;
+  return "error max " + offline::general_text(max_error) + " exceeds --error " + offline::general_text(s.tolerance) +
+         (s.tolerance_in_percent ? "%" : "") + " (" + offline::general_text(tolerance_units) + " units), which --keys " +
+         mode + " does not enforce";
 }
 
 nlohmann::json encode_summary(const std::string& input, const std::string& output, const offline::Motion& motion,

@@ -68,6 +68,10 @@ class Loader {
   }
 
   Status read_header_and_table();
+  // Spec section 8: a compressed section's Raw_Size against the most its Stored_Size can make
+  // (internal::kMaxZstdExpansion), after the raw-size limit and before the checksum: a small
+  // file declaring a large section is refused from the table (zstd_error, as inflating it would be).
+  Status check_expansion();
   // `critical` (0..4, CLIP..KVAL; -1 for NOTE) bounds a compressed section's Raw_Size by
   // check_declared_size once its zstd frame header is checked, before it is inflated.
   Status get_content(const TableEntry& e, const char* name, Content& out, int critical = -1,

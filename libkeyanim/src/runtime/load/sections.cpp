@@ -42,6 +42,12 @@ Status Loader::parse_clip(const Content& c, ClipSource& parts) {
     return fail_in(Status::corrupt, c, 16, "Frame_Time must be finite, >= 0, and > 0 when Frame_Count > 1");
   if (key_count_ > limits_.max_keys)
     return fail_in(Status::limit_exceeded, c, 24, "Key_Count " + std::to_string(key_count_) + " exceeds the limit");
+  if (key_count_ > internal::kMaxKeysPerFileByte * uint64_t(bytes_.size()))
+    return fail_in(Status::corrupt, c, 24,
+                   "Key_Count " + std::to_string(key_count_) + " is more than a file of " + std::to_string(bytes_.size()) +
+                       " bytes can hold (at most " + std::to_string(internal::kMaxKeysPerFileByte) +
+                       " keys a byte: a key takes a byte of KTIM at least, and zstd makes at most " +
+                       std::to_string(internal::kMaxZstdExpansion) + " bytes of each)");
   if (key_count_ > UINT32_MAX)
     return fail_in(Status::limit_exceeded, c, 24, "this decoder holds fewer than 2^32 keys");
   if (key_count_ > uint64_t(channel_count_) * frames)

@@ -114,8 +114,13 @@ Status Loader::read_header_and_table() {
     if (e.raw > limits_.max_decompressed_bytes - raw_total || e.raw > limits_.max_decompressed_bytes)
       return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
                   "decompressed sections exceed the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
+    if (e.tag == internal::kTagNote && e.raw > limits_.max_note_bytes)
+      return fail(Status::limit_exceeded, "table", e.entry_offset + 16,
+                  "NOTE declares " + std::to_string(e.raw) + " bytes, above the limit of " +
+                      std::to_string(limits_.max_note_bytes) + " (notes are informative text)");
     raw_total += e.raw;
   }
+  if (Status s = check_expansion(); s != Status::ok) return s;
 
   uLong crc = crc32(0L, Z_NULL, 0);
   for (uint64_t done = 0; done < pos;) {
@@ -126,6 +131,20 @@ Status Loader::read_header_and_table() {
   const uint32_t stored_crc = internal::load_le<uint32_t>(p + pos);
   if (static_cast<uint32_t>(crc) != stored_crc)
     return fail(Status::checksum_mismatch, "checksum", pos, "CRC-32 of the file does not match its checksum");
+  return Status::ok;
+}
+
+Status Loader::check_expansion() {
+  for (size_t i = 0; i < table_.size(); ++i) {
+    const TableEntry& e = table_[i];
+    const bool known = e.tag == internal::kTagNote || !(e.flags & internal::kSectionAncillary);
+    // stored <= file size < 2^48: the product is exact.
+    if (known && (e.flags & internal::kSectionCompressed) && e.raw > internal::kMaxZstdExpansion * e.stored)
+      return fail(Status::zstd_error, "table", e.entry_offset + 16,
+                  "section " + std::to_string(i) + " (" + tag_name(e.tag) + "): Raw_Size " + std::to_string(e.raw) +
+                      " is more than its " + std::to_string(e.stored) + " stored bytes can make (a zstd frame makes at most " +
+                      std::to_string(internal::kMaxZstdExpansion) + " bytes of each)");
+  }
   return Status::ok;
 }
 

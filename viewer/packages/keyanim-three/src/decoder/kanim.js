@@ -15,9 +15,18 @@ const CRITICAL = ['CLIP', 'SKEL', 'CHAN', 'KTIM', 'KVAL'];
 export const CHANNEL_TYPES = ['Xposition', 'Yposition', 'Zposition', 'Xrotation', 'Yrotation', 'Zrotation'];
 export const MAX_FRAMES_V3 = 2 ** 24;
 
+// Spec section 8, limits that follow from the file's size: no zstd frame makes more than 32768
+// bytes of each of its bytes (a 4-byte RLE block makes 128 KiB at most, the best any block
+// does), and a key takes a byte of KTIM at least. So a compressed section holds at most 32768
+// times its Stored_Size, and a file of N bytes at most 32768 N keys: counts beyond are refused
+// as they are read, before anything is inflated or allocated, with the status a later step
+// would give (zstd_error, corrupt).
+export const MAX_ZSTD_EXPANSION = 32768;
+export const MAX_KEYS_PER_FILE_BYTE = MAX_ZSTD_EXPANSION;
+
 // keyanim's defaults (spec section 8).
 export const DEFAULT_LIMITS = Object.freeze({
-  nodes: 65536, channels: 262144, frames: 2 ** 24, keys: 268435456, rawBytes: 2 ** 30,
+  nodes: 65536, channels: 262144, frames: 2 ** 24, keys: 268435456, rawBytes: 2 ** 30, noteBytes: 2 ** 24,
 });
 
 // True when the bytes start like a .kanim file (the signature), for telling it from a BVH.
@@ -77,7 +86,12 @@ function readContainer(bytes, limits) {
   for (const s of sections) {
     if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
     if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `the sections decode to ${raw} bytes or more, above the limit of ${limits.rawBytes}`);
+    if (s.tag === 'NOTE' && s.rawSize > BigInt(limits.noteBytes ?? DEFAULT_LIMITS.noteBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `NOTE declares ${s.rawSize} bytes, above the limit of ${limits.noteBytes ?? DEFAULT_LIMITS.noteBytes} (notes are informative text)`);
   }
+  sections.forEach((s, i) => {
+    if (SECTION_PARSERS[s.tag] && s.compressed && s.rawSize > BigInt(MAX_ZSTD_EXPANSION) * s.storedSize)
+      fail('zstd_error', 'section table', s.entry + 16, `section ${i} (${s.tag}): Raw_Size ${s.rawSize} is more than its ${s.storedSize} stored bytes can make (a zstd frame makes at most ${MAX_ZSTD_EXPANSION} bytes of each)`);
+  });
   const stored = view.getUint32(bytes.length - 4, true), computed = crc32(bytes.subarray(0, bytes.length - 4));
   if (stored !== computed) fail('checksum_mismatch', 'checksum', bytes.length - 4, `CRC-32 is 0x${hex8(computed)}, the file says 0x${hex8(stored)}`);
   return { version: { major, minor }, sections };
@@ -163,6 +177,7 @@ function parseClip(r, clip, limits) {
   if (frames > 1 && !(frameTime > 0)) r.fail('corrupt', 16, `Frame_Time is 0 with ${frames} frames`);
   const keys = r.u64();
   if (keys > BigInt(limits.keys)) r.fail('limit_exceeded', 24, `Key_Count ${keys} is above the limit of ${limits.keys}`);
+  if (keys > BigInt(MAX_KEYS_PER_FILE_BYTE) * BigInt(clip.fileBytes)) r.fail('corrupt', 24, `Key_Count ${keys} is more than a file of ${clip.fileBytes} bytes can hold (at most ${MAX_KEYS_PER_FILE_BYTE} keys a byte: a key takes a byte of KTIM at least, and zstd makes at most ${MAX_ZSTD_EXPANSION} bytes of each)`);
   if (keys > BigInt(channels) * BigInt(frames)) r.fail('corrupt', 24, `Key_Count ${keys} is above Channel_Count x Frame_Count`);
   Object.assign(clip, { frameCount: frames, nodeCount: nodes, channelCount: channels, tangentRule: rule, frameTime, keyCount: Number(keys) });
 }
