@@ -23,6 +23,9 @@ struct F4 {
   explicit F4(__m128 x) : v(x) {}
   explicit F4(float x) : v(_mm_set1_ps(x)) {}
   static F4 load(const float* p) { return F4(_mm_loadu_ps(p)); }
+  // Lanes from scalars, in registers (a vector load of four values just stored one by one
+  // would wait for the stores: a store-forwarding stall).
+  static F4 set(float a, float b, float c, float d) { return F4(_mm_setr_ps(a, b, c, d)); }
   static F4 load_mask(const uint32_t* p) { return F4(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)))); }
   void store(float* p) const { _mm_storeu_ps(p, v); }
 };
@@ -62,6 +65,7 @@ struct F4 {
   F4() = default;
   explicit F4(float x) { v[0] = v[1] = v[2] = v[3] = x; }
   static F4 load(const float* p) { F4 r; std::memcpy(r.v, p, sizeof r.v); return r; }
+  static F4 set(float a, float b, float c, float d) { F4 r; r.v[0] = a, r.v[1] = b, r.v[2] = c, r.v[3] = d; return r; }
   static F4 load_mask(const uint32_t* p) { F4 r; std::memcpy(r.v, p, sizeof r.v); return r; }
   void store(float* p) const { std::memcpy(p, v, sizeof v); }
 };

@@ -43,10 +43,9 @@ KEYANIM_INLINE inline void group_rotations(const Rig& rig, const Rig::RotationGr
     Quat4 q{F4(0.0f), F4(0.0f), F4(0.0f), F4(1.0f)};
     for (uint32_t k = 0; k < g.steps; ++k) {
       const uint32_t* column = rig.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
-      alignas(16) float angle[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-      for (uint32_t l = 0; l < lanes; ++l) angle[l] = values[column[l] - column0];
+      auto angle = [&](uint32_t l) { return l < lanes ? values[column[l] - column0] : 0.0f; };
       F4 s, c;
-      half_sincos_deg(F4::load(angle), s, c);
+      half_sincos_deg(F4::set(angle(0), angle(1), angle(2), angle(3)), s, c);
       q = rotate_by(q, g.axis[k], s, c);
     }
     transpose(q.x, q.y, q.z, q.w);  // now lane rows: node i's (x, y, z, w) in q.x, i + 1's in q.y, ...
