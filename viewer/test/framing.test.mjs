@@ -1,7 +1,7 @@
 // What the viewer's camera follows and frames (src/framing.js), and the up axis it shows
 // (src/upaxis.js), on a Bandai-like clip (test/bandai-like.mjs: a ROOT that stays at the origin,
-// its child Hips walking 800 units), on data/'s CMU walk and, when the corpus is there, on
-// Bandai's walk and MakeHuman's z-up files. "In the picture" is checked with three.js's own
+// its child Hips walking 800 units), and on data/'s CMU walk (the corpus' Bandai walk and
+// MakeHuman's z-up files: framing_corpus.test.mjs). "In the picture" is checked with three.js's own
 // camera: every point projects inside the view (normalized device coordinates within [-1, 1]).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -9,51 +9,12 @@ import fs from 'node:fs';
 import path from 'node:path';
 import * as THREE from 'three';
 import { parseBvh } from '../src/bvh.js';
-import { clipExtent, followedPoint, fitCamera, VIEW_DIRECTION } from '../src/framing.js';
-import { detectUpAxis, toYUp } from '../src/upaxis.js';
-import { worldPositions, skeletonSize } from 'keyanim-three/decoder/pose.js';
+import { followedPoint, fitCamera, VIEW_DIRECTION } from '../src/framing.js';
+import { detectUpAxis } from '../src/upaxis.js';
+import { skeletonSize } from 'keyanim-three/decoder/pose.js';
+import { ASPECT, FOV, poses, extentOf, camera, outside, expectFramed } from './framing-check.mjs';
 import { bandaiLikeBvh } from './bandai-like.mjs';
-import { sourceDir, corpusDir, exists } from './paths.mjs';
-
-const ASPECT = 1.6, FOV = 40;
-const poses = (bvh, up = 'y') => Array.from({ length: bvh.frameCount }, (_, f) =>
-  toYUp(worldPositions(bvh.nodes, bvh.frames.subarray(f * bvh.channelCount, (f + 1) * bvh.channelCount)), up));
-const extentOf = (bvh, p) => clipExtent(bvh.nodes, bvh.frameCount, (f) => p[f], skeletonSize(bvh.nodes));
-
-function camera(fit) {
-  const c = new THREE.PerspectiveCamera(FOV, ASPECT, 0.01, 1e6);
-  c.position.fromArray(fit.position);
-  c.lookAt(new THREE.Vector3().fromArray(fit.target));
-  c.updateMatrixWorld();
-  return c;
-}
-
-// The nodes (indices) at frame f that project outside the camera moved by `shift`.
-function outside(cam, positions, shift, nodes) {
-  const out = [], v = new THREE.Vector3();
-  for (const i of nodes) {
-    v.set(positions[3 * i] - shift[0], positions[3 * i + 1] - shift[1], positions[3 * i + 2] - shift[2]).project(cam);
-    if (!(Math.abs(v.x) <= 1 && Math.abs(v.y) <= 1 && Math.abs(v.z) < 1)) out.push(i);
-  }
-  return out;
-}
-
-// Every node in the picture at every frame: without following, the camera on the clip's box;
-// following, the camera on the body's box and moved with the followed point.
-function expectFramed(bvh, p, label) {
-  const e = extentOf(bvh, p), all = bvh.nodes.map((_, i) => i), body = all.filter((i) => !e.placeholders[i]);
-  const still = camera(fitCamera(e.world, { aspect: ASPECT, fovDegrees: FOV }));
-  const c0 = followedPoint(p[0], e.placeholders);
-  const moving = camera(fitCamera(e.body, { aspect: ASPECT, fovDegrees: FOV, offset: c0 }));
-  for (let f = 0; f < p.length; ++f) {
-    const lost = outside(still, p[f], [0, 0, 0], all);
-    assert.deepEqual(lost, [], `${label}, frame ${f}, whole-clip framing: ${lost.map((i) => bvh.nodes[i].name)} outside`);
-    const c = followedPoint(p[f], e.placeholders), shift = c.map((x, r) => x - c0[r]);
-    const lostFollowing = outside(moving, p[f], shift, body);
-    assert.deepEqual(lostFollowing, [], `${label}, frame ${f}, following: ${lostFollowing.map((i) => bvh.nodes[i].name)} outside`);
-  }
-  return e;
-}
+import { sourceDir } from './paths.mjs';
 
 test('Bandai-like: the static ROOT is a placeholder; the followed point moves with Hips', () => {
   const bvh = parseBvh(bandaiLikeBvh()), p = poses(bvh), e = extentOf(bvh, p), size = skeletonSize(bvh.nodes);
@@ -93,13 +54,6 @@ test("data/'s CMU walk: no placeholder (Hips is the moving root), every joint fr
   assert.equal(e.placeholders.reduce((a, b) => a + b, 0), 0);
 });
 
-const bandaiWalk = path.join(corpusDir, 'bandai/dataset-1_walk_normal_001.bvh');
-test("the corpus's Bandai walk: joint_Root alone is a placeholder, every joint framed", { skip: exists(bandaiWalk) ? false : `no corpus at ${corpusDir}` }, () => {
-  const bvh = parseBvh(fs.readFileSync(bandaiWalk, 'utf8'));
-  const e = expectFramed(bvh, poses(bvh), 'Bandai walk');
-  assert.deepEqual(bvh.nodes.map((n, i) => e.placeholders[i] ? n.name : null).filter(Boolean), ['joint_Root']);
-});
-
 test('a one-point clip gets a camera at some distance (minRadius), not on the point', () => {
   const point = { min: [1, 2, 3], max: [1, 2, 3] };
   const fit = fitCamera(point, { minRadius: 0.5, fovDegrees: FOV, aspect: ASPECT });
@@ -123,10 +77,3 @@ test('up axis: y detected on y-up skeletons, z on z-up ones; a z-up clip is show
   assert.deepEqual([detectUpAxis(cube.nodes).axis, detectUpAxis(cube.nodes).ambiguous], ['y', true]);
 });
 
-test("up axis on the corpus: MakeHuman's files are z-up, Bandai's and CMU's y-up", { skip: exists(corpusDir) ? false : `no corpus at ${corpusDir}` }, () => {
-  const want = { 'misc/makehuman__zombieWalk1.bvh': 'z', 'misc/makehuman__tpose.bvh': 'z', 'bandai/dataset-1_walk_normal_001.bvh': 'y', 'cmu/BvhToDeepMimic__02_01.bvh': 'y' };
-  for (const [file, axis] of Object.entries(want)) {
-    const got = detectUpAxis(parseBvh(fs.readFileSync(path.join(corpusDir, file), 'utf8')).nodes);
-    assert.deepEqual([got.axis, got.ambiguous], [axis, false], file);
-  }
-});
