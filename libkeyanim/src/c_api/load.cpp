@@ -40,6 +40,21 @@ keyanim_status load_into(const char* function, keyanim_clip** out, const keyanim
   }
 }
 
+// Clip::load of `size` bytes (NULL with 0: an empty input) into a new handle, through `rigs`
+// when given: keyanim_clip_load_limited and keyanim_clip_load_shared.
+keyanim_status load_bytes(const char* function, const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
+                          RigCache* rigs, keyanim_clip** out) {
+  if (bytes == nullptr && size != 0) {
+    if (out != nullptr) *out = nullptr;
+    return fail(Status::invalid_argument, function, "bytes is NULL and size is %zu", size);
+  }
+  static const uint8_t kNone = 0;  // a span of 0 bytes still needs an address
+  const uint8_t* data = bytes != nullptr ? bytes : &kNone;
+  return load_into(function, out, limits, [&](Clip& clip, ErrorInfo& info, const DecodeLimits& l) {
+    return Clip::load({data, size}, clip, &info, l, rigs);
+  });
+}
+
 }  // namespace
 }  // namespace keyanim::c_api
 
@@ -59,16 +74,7 @@ void keyanim_decode_limits_default(keyanim_decode_limits* out) {
 
 keyanim_status keyanim_clip_load_limited(const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
                                          keyanim_clip** out) {
-  const char* fn = "keyanim_clip_load";
-  if (bytes == nullptr && size != 0) {
-    if (out != nullptr) *out = nullptr;
-    return fail(Status::invalid_argument, fn, "bytes is NULL and size is %zu", size);
-  }
-  static const uint8_t kNone = 0;  // a span of 0 bytes still needs an address
-  const uint8_t* data = bytes != nullptr ? bytes : &kNone;
-  return load_into(fn, out, limits, [&](Clip& clip, ErrorInfo& info, const DecodeLimits& l) {
-    return Clip::load({data, size}, clip, &info, l);
-  });
+  return load_bytes("keyanim_clip_load", bytes, size, limits, nullptr, out);
 }
 
 keyanim_status keyanim_clip_load(const uint8_t* bytes, size_t size, keyanim_clip** out) {
@@ -78,17 +84,11 @@ keyanim_status keyanim_clip_load(const uint8_t* bytes, size_t size, keyanim_clip
 keyanim_status keyanim_clip_load_shared(const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
                                         keyanim_rig_cache* rigs, keyanim_clip** out) {
   const char* fn = "keyanim_clip_load_shared";
-  if ((bytes == nullptr && size != 0) || rigs == nullptr || was_freed_rigs(rigs)) {
+  if (rigs == nullptr || was_freed_rigs(rigs)) {
     if (out != nullptr) *out = nullptr;
-    if (rigs == nullptr) return fail(Status::invalid_argument, fn, "rigs is NULL");
-    if (was_freed_rigs(rigs)) return fail(Status::invalid_argument, fn, "rigs was freed");
-    return fail(Status::invalid_argument, fn, "bytes is NULL and size is %zu", size);
+    return fail(Status::invalid_argument, fn, rigs == nullptr ? "rigs is NULL" : "rigs was freed");
   }
-  static const uint8_t kNone = 0;
-  const uint8_t* data = bytes != nullptr ? bytes : &kNone;
-  return load_into(fn, out, limits, [&](Clip& clip, ErrorInfo& info, const DecodeLimits& l) {
-    return Clip::load({data, size}, clip, &info, l, &rigs->rigs);
-  });
+  return load_bytes(fn, bytes, size, limits, &rigs->rigs, out);
 }
 
 keyanim_status keyanim_clip_load_file_limited(const char* path, const keyanim_decode_limits* limits,
