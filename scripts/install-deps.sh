@@ -21,6 +21,7 @@ REQUIRED=(
   ccache           # scripts/configure.sh: the test builds reuse what the set-up compiled
   bash-completion  # tab completion of the installed tool (tools/completion/keyanim)
   parallel procps  # tests/cli/manifest_test.sh runs the README's GNU parallel recipe (and kills it)
+  libxxhash-dev python3-xxhash  # the runtime profile's checksum, XXH64 (spec/FORMAT.md section 9)
   locales          # python/tests/test_hostile.py compiles de_DE.UTF-8 (localedef) into its own directory
   # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
   # matplotlib for examples/plot_channel.py.

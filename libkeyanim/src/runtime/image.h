@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@
 #include "internal/format.h"
 #include "keyanim/cardinal.h"
 #include "keyanim/skeleton.h"
+#include "runtime/image_layout.h"
 #include "runtime/rig.h"
 
 namespace keyanim {
@@ -45,8 +47,9 @@ inline constexpr uint32_t kBlockFrames = 1u << kBlockShift;
 inline constexpr uint32_t kRecordBitsAt = 80;  // Context starts after Mask, Value_Bits, Context_Bits
 inline constexpr uint32_t kContextKeys = 4;
 inline constexpr uint32_t kNoCurve = UINT32_MAX;
-inline constexpr uint32_t kPrefetchRecords = 8;  // see Image::record_offset
-inline constexpr size_t kPayloadPadding = 8;  // so that an 8-byte load at any record bit is in bounds
+inline constexpr uint32_t kPrefetchRecords = kImageTailEntries;  // see Image::record_offset
+// so that an 8-byte load at any record bit is in bounds
+inline constexpr size_t kPayloadPadding = kImageTailEntries;
 
 // Per block curve, what reading its records needs (the rest is in Image's per-curve arrays):
 // 24 bytes, since a cold pose reads one per curve.
@@ -61,6 +64,10 @@ struct ListSpan {
   uint32_t first = 0, count = 0;
 };
 
+// The image's arrays are spans into its IMAG bytes (spec/FORMAT.md section 9.2, the runtime
+// profile): the bytes build_image wrote (owned by `storage`), a runtime-profile file copied by
+// Clip::load (owned too), or caller-owned bytes viewed by Clip::view (no owner: the caller keeps
+// them alive). Either way the sampler reads the same layout.
 struct Image {
   // The clip.
   uint16_t version_major = 0, version_minor = 0;
@@ -73,35 +80,40 @@ struct Image {
   std::string notes;
   uint64_t total_keys = 0;
   uint64_t id = 0;  // distinguishes clips for cursors (an address can be reused)
+  std::shared_ptr<const void> storage;  // the bytes the spans below point into, unless viewed
+  std::span<const uint8_t> imag;        // IMAG's content, 8-aligned
+  size_t held_bytes = 0;                // bytes `storage` holds (the file's, or IMAG's)
 
   // Per channel (frame column).
-  std::vector<Interpolation> interp;
-  std::vector<float> tension;
-  std::vector<uint32_t> key_count;
-  std::vector<uint32_t> curve_of;  // index into curves, or kNoCurve
-  std::vector<float> fixed_value;  // the value of a channel with fewer than two keys
-  std::vector<uint32_t> fixed_frame;  // the frame of a channel's single key (0 without keys)
-  std::vector<uint32_t> fixed_channels;  // channels with fewer than two keys, in order
+  std::span<const Interpolation> interp;
+  std::span<const float> tension;
+  std::span<const uint32_t> key_count;
+  std::span<const uint32_t> curve_of;  // index into curves, or kNoCurve
+  std::span<const float> fixed_value;  // the value of a channel with fewer than two keys
+  std::span<const uint32_t> fixed_frame;  // the frame of a channel's single key (0 without keys)
+  std::span<const uint32_t> fixed_channels;  // channels with fewer than two keys, in order
 
   // Curves and their records. The per-curve arrays are separate so that 4 curves load at once.
   // Curves [0, block_curves) have a record per block; the others, sparse ones (fewer keys than
   // a quarter of the blocks), keep a plain list of keys instead, so that the image stays
   // linear in the keys whatever the frame count.
-  std::vector<Curve> curves;
+  std::span<const Curve> curves;
   uint32_t block_curves = 0;
-  std::vector<ListSpan> lists;           // list curve block_curves + i: lists[i]
-  std::vector<uint32_t> list_frames;     // list curves' key frames, curve after curve
-  std::vector<float> list_values;        // and their values
-  std::vector<float> curve_s;            // (1 - tension) / 2
-  std::vector<float> first_frame, last_frame;  // K_0 and K_{n-1}
-  std::vector<float> first_value, last_value;  // v_0 and v_{n-1}
-  std::vector<uint32_t> curve_linear;    // all ones: linear interpolation
-  std::vector<uint32_t> curve_channel;   // curve i's output column (channel)
+  std::span<const ListSpan> lists;       // list curve block_curves + i: lists[i]
+  std::span<const uint32_t> list_frames; // list curves' key frames, curve after curve
+  std::span<const float> list_values;    // and their values
+  std::span<const int64_t> list_q;       // and their quantized values (for conversion)
+  // Padded to whole groups of 4 lanes (ImageLayout::lanes).
+  std::span<const float> curve_s;        // (1 - tension) / 2
+  std::span<const float> first_frame, last_frame;  // K_0 and K_{n-1}
+  std::span<const float> first_value, last_value;  // v_0 and v_{n-1}
+  std::span<const uint32_t> curve_linear;    // all ones: linear interpolation
+  std::span<const uint32_t> curve_channel;   // curve i's output column (channel)
   uint32_t block_count = 0;
   // [block * block_curves + curve]: byte offset in payload; kPrefetchRecords extra zeros at the
   // end, so that the sampler may read the offset of a record a few curves ahead unchecked.
-  std::vector<uint32_t> record_offset;
-  std::vector<uint8_t> payload;         // records, then kPayloadPadding zero bytes
+  std::span<const uint32_t> record_offset;
+  std::span<const uint8_t> payload;      // records, then kPayloadPadding zero bytes
 
   const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
     return payload.data() + record_offset[size_t(block) * block_curves + curve];
@@ -110,6 +122,12 @@ struct Image {
   size_t animation_bytes() const noexcept;  // the rest (image_build.cpp)
   size_t memory_bytes() const noexcept { return skeleton_bytes() + animation_bytes(); }
 };
+
+// IMAG's counts: its header's, and CLIP's channel count.
+ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept;
+// Points `img`'s arrays into `imag` (IMAG's content, 8-aligned), whose header and sizes are
+// known to be valid (built by build_image, or checked by the viewer): no check here.
+void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) noexcept;
 
 // Builds the image of a valid source (its keys decoded, every rule checked). With `rigs`, the
 // skeleton is the cache's rig when it holds an equal one (rig.h).

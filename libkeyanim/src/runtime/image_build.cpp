@@ -102,37 +102,118 @@ void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t s
     w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
 }
 
-// The arrays were grown by push_back: give back what they reserved beyond their size (up to
-// half of each), since a loaded clip lives long.
-void shrink(Image& img) {
-  img.fixed_channels.shrink_to_fit();
-  img.curves.shrink_to_fit();
-  img.lists.shrink_to_fit();
-  img.list_frames.shrink_to_fit();
-  img.list_values.shrink_to_fit();
-  for (auto* v : {&img.curve_s, &img.first_frame, &img.last_frame, &img.first_value, &img.last_value})
-    v->shrink_to_fit();
-  img.curve_linear.shrink_to_fit();
-  img.curve_channel.shrink_to_fit();
-  img.notes.shrink_to_fit();
+// The image's arrays as build_image fills them, before they are written as IMAG (Image's
+// members, as vectors).
+struct Arrays {
+  std::vector<Interpolation> interp;
+  std::vector<float> tension;
+  std::vector<uint32_t> key_count, curve_of;
+  std::vector<float> fixed_value;
+  std::vector<uint32_t> fixed_frame, fixed_channels;
+  std::vector<Curve> curves;
+  uint32_t block_curves = 0;
+  std::vector<ListSpan> lists;
+  std::vector<uint32_t> list_frames;
+  std::vector<float> list_values;
+  std::vector<int64_t> list_q;
+  std::vector<float> curve_s, first_frame, last_frame, first_value, last_value;
+  std::vector<uint32_t> curve_linear, curve_channel;
+  uint32_t block_count = 0;
+  std::vector<uint32_t> record_offset;
+  std::vector<uint8_t> payload;  // records, then kPayloadPadding zero bytes
+};
+
+template <class T>
+void put_array(uint8_t* imag, const ImageLayout& at, ImageLayout::Array a, const std::vector<T>& v) noexcept {
+  if (!v.empty()) std::memcpy(imag + at.at[a], v.data(), v.size() * sizeof(T));
+}
+
+// IMAG's bytes (spec section 9.2) in a zeroed, 8-aligned buffer, and the image pointed into it.
+void write_imag(const Arrays& a, Image& img) {
+  const ImageCounts n{a.interp.size(), a.curves.size(), a.block_curves, a.block_count, a.list_frames.size(),
+                      a.payload.size() - kPayloadPadding};
+  const ImageLayout at(n);
+  auto words = std::make_shared<uint64_t[]>(at.end() / 8);
+  uint8_t* imag = reinterpret_cast<uint8_t*>(words.get());
+  const uint32_t header[6] = {kBlockShift, uint32_t(n.curves), uint32_t(n.block_curves), uint32_t(n.blocks),
+                              uint32_t(n.list_keys), uint32_t(n.payload)};
+  std::memcpy(imag, header, sizeof header);
+  using L = ImageLayout;
+  put_array(imag, at, L::interpolation, a.interp);
+  put_array(imag, at, L::tension, a.tension);
+  put_array(imag, at, L::key_count, a.key_count);
+  put_array(imag, at, L::curve_of, a.curve_of);
+  put_array(imag, at, L::fixed_value, a.fixed_value);
+  put_array(imag, at, L::fixed_frame, a.fixed_frame);
+  put_array(imag, at, L::fixed_channels, a.fixed_channels);
+  put_array(imag, at, L::curves, a.curves);
+  put_array(imag, at, L::curve_s, a.curve_s);
+  put_array(imag, at, L::first_frame, a.first_frame);
+  put_array(imag, at, L::last_frame, a.last_frame);
+  put_array(imag, at, L::first_value, a.first_value);
+  put_array(imag, at, L::last_value, a.last_value);
+  put_array(imag, at, L::curve_linear, a.curve_linear);
+  put_array(imag, at, L::curve_channel, a.curve_channel);
+  put_array(imag, at, L::lists, a.lists);
+  put_array(imag, at, L::list_frames, a.list_frames);
+  put_array(imag, at, L::list_values, a.list_values);
+  put_array(imag, at, L::list_q, a.list_q);
+  put_array(imag, at, L::record_offset, a.record_offset);
+  put_array(imag, at, L::payload, a.payload);
+  img.held_bytes = at.end();
+  img.storage = std::move(words);
+  attach_image(img, {imag, at.end()}, uint32_t(n.channels));
 }
 
 }  // namespace
 
-// The motion: keys, per-channel and per-curve facts, records, notes, and the image itself.
+// The motion: IMAG's bytes (owned, or viewed: the clip needs them resident either way), notes,
+// and the image itself.
 size_t Image::animation_bytes() const noexcept {
-  size_t n = sizeof(Image) + notes.capacity();
-  n += interp.capacity() * sizeof(Interpolation) + tension.capacity() * sizeof(float);
-  n += key_count.capacity() * sizeof(uint32_t) + curve_of.capacity() * sizeof(uint32_t);
-  n += fixed_frame.capacity() * sizeof(uint32_t) + fixed_value.capacity() * sizeof(float) + fixed_channels.capacity() * sizeof(uint32_t);
-  n += curve_s.capacity() * sizeof(float) + first_frame.capacity() * sizeof(float) +
-       last_frame.capacity() * sizeof(float) + first_value.capacity() * sizeof(float) +
-       last_value.capacity() * sizeof(float) + curve_linear.capacity() * sizeof(uint32_t) +
-       curve_channel.capacity() * sizeof(uint32_t);
-  n += lists.capacity() * sizeof(ListSpan) + list_frames.capacity() * sizeof(uint32_t) +
-       list_values.capacity() * sizeof(float);
-  n += curves.capacity() * sizeof(Curve) + record_offset.capacity() * sizeof(uint32_t) + payload.capacity();
-  return n;
+  return sizeof(Image) + notes.capacity() + std::max(held_bytes, imag.size());
+}
+
+template <class T>
+std::span<const T> array_at(std::span<const uint8_t> imag, const ImageLayout& at, ImageLayout::Array a,
+                            uint64_t count) noexcept {
+  return {reinterpret_cast<const T*>(imag.data() + at.at[a]), static_cast<size_t>(count)};
+}
+
+ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept {
+  uint32_t h[6];
+  std::memcpy(h, imag.data(), sizeof h);
+  return {channels, h[1], h[2], h[3], h[4], h[5]};
+}
+
+void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) noexcept {
+  const ImageCounts n = image_counts(imag, channels);
+  const ImageLayout at(n);
+  using L = ImageLayout;
+  const uint64_t c = n.channels, lanes = L::lanes(n.curves), lists = n.curves - n.block_curves;
+  img.imag = imag;
+  img.interp = array_at<Interpolation>(imag, at, L::interpolation, c);
+  img.tension = array_at<float>(imag, at, L::tension, c);
+  img.key_count = array_at<uint32_t>(imag, at, L::key_count, c);
+  img.curve_of = array_at<uint32_t>(imag, at, L::curve_of, c);
+  img.fixed_value = array_at<float>(imag, at, L::fixed_value, c);
+  img.fixed_frame = array_at<uint32_t>(imag, at, L::fixed_frame, c);
+  img.fixed_channels = array_at<uint32_t>(imag, at, L::fixed_channels, c - n.curves);
+  img.curves = array_at<Curve>(imag, at, L::curves, n.curves);
+  img.block_curves = static_cast<uint32_t>(n.block_curves);
+  img.lists = array_at<ListSpan>(imag, at, L::lists, lists);
+  img.list_frames = array_at<uint32_t>(imag, at, L::list_frames, n.list_keys);
+  img.list_values = array_at<float>(imag, at, L::list_values, n.list_keys);
+  img.list_q = array_at<int64_t>(imag, at, L::list_q, n.list_keys);
+  img.curve_s = array_at<float>(imag, at, L::curve_s, lanes);
+  img.first_frame = array_at<float>(imag, at, L::first_frame, lanes);
+  img.last_frame = array_at<float>(imag, at, L::last_frame, lanes);
+  img.first_value = array_at<float>(imag, at, L::first_value, lanes);
+  img.last_value = array_at<float>(imag, at, L::last_value, lanes);
+  img.curve_linear = array_at<uint32_t>(imag, at, L::curve_linear, lanes);
+  img.curve_channel = array_at<uint32_t>(imag, at, L::curve_channel, n.curves);
+  img.block_count = static_cast<uint32_t>(n.blocks);
+  img.record_offset = array_at<uint32_t>(imag, at, L::record_offset, n.blocks * n.block_curves + kPrefetchRecords);
+  img.payload = array_at<uint8_t>(imag, at, L::payload, n.payload + kPayloadPadding);
 }
 
 std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
@@ -148,30 +229,31 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
   static std::atomic<uint64_t> next_id{1};
   img->id = next_id.fetch_add(1, std::memory_order_relaxed);
 
+  Arrays a;
   const size_t channels = src.channels.size();
-  img->interp.resize(channels);
-  img->tension.resize(channels);
-  img->key_count.resize(channels);
-  img->curve_of.assign(channels, kNoCurve);
-  img->fixed_value.assign(channels, 0.0f);
-  img->fixed_frame.assign(channels, 0);
+  a.interp.resize(channels);
+  a.tension.resize(channels);
+  a.key_count.resize(channels);
+  a.curve_of.assign(channels, kNoCurve);
+  a.fixed_value.assign(channels, 0.0f);
+  a.fixed_frame.assign(channels, 0);
   const uint64_t blocks = (uint64_t(src.frame_count) + kBlockFrames - 1) / kBlockFrames;
   // Block curves first, then list curves (two passes over the channels).
   for (int pass = 0; pass < 2; ++pass) {
     for (size_t c = 0; c < channels; ++c) {
       const SourceChannel& sc = src.channels[c];
       if (pass == 0) {
-        img->interp[c] = sc.interp;
-        img->tension[c] = sc.tension;
-        img->key_count[c] = sc.key_count;
+        a.interp[c] = sc.interp;
+        a.tension[c] = sc.tension;
+        a.key_count[c] = sc.key_count;
       }
       if (sc.key_count < 2) {
         if (pass == 1) continue;
         if (sc.key_count == 1) {
-          img->fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
-          img->fixed_frame[c] = src.frames[sc.first_key];
+          a.fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
+          a.fixed_frame[c] = src.frames[sc.first_key];
         }
-        img->fixed_channels.push_back(static_cast<uint32_t>(c));
+        a.fixed_channels.push_back(static_cast<uint32_t>(c));
         continue;
       }
       const uint32_t n = sc.key_count;
@@ -184,43 +266,44 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
       cv.q_base = *lo;
       cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
       if (pass == 1) {
-        img->lists.push_back({static_cast<uint32_t>(img->list_frames.size()), n});
-        img->list_frames.insert(img->list_frames.end(), k, k + n);
-        for (uint32_t i = 0; i < n; ++i) img->list_values.push_back(dequantize(q[i], sc.step));
+        a.lists.push_back({static_cast<uint32_t>(a.list_frames.size()), n});
+        a.list_frames.insert(a.list_frames.end(), k, k + n);
+        for (uint32_t i = 0; i < n; ++i) a.list_values.push_back(dequantize(q[i], sc.step));
+        a.list_q.insert(a.list_q.end(), q, q + n);
       }
-      img->curve_s.push_back(tension_to_s(sc.tension));
-      img->first_frame.push_back(static_cast<float>(k[0]));
-      img->last_frame.push_back(static_cast<float>(k[n - 1]));
-      img->first_value.push_back(dequantize(q[0], sc.step));
-      img->last_value.push_back(dequantize(q[n - 1], sc.step));
-      img->curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
-      img->curve_of[c] = static_cast<uint32_t>(img->curves.size());
-      img->curves.push_back(cv);
-      img->curve_channel.push_back(static_cast<uint32_t>(c));
+      a.curve_s.push_back(tension_to_s(sc.tension));
+      a.first_frame.push_back(static_cast<float>(k[0]));
+      a.last_frame.push_back(static_cast<float>(k[n - 1]));
+      a.first_value.push_back(dequantize(q[0], sc.step));
+      a.last_value.push_back(dequantize(q[n - 1], sc.step));
+      a.curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
+      a.curve_of[c] = static_cast<uint32_t>(a.curves.size());
+      a.curves.push_back(cv);
+      a.curve_channel.push_back(static_cast<uint32_t>(c));
     }
-    if (pass == 0) img->block_curves = static_cast<uint32_t>(img->curves.size());
+    if (pass == 0) a.block_curves = static_cast<uint32_t>(a.curves.size());
   }
 
-  const size_t nc = img->curves.size();
+  const size_t nc = a.curves.size();
   // The per-curve arrays are read 4 curves at a time: pad them to whole lanes (never "in" a
   // segment: the padding lanes are clamped constants).
   const size_t lanes = (nc + 3) & ~size_t(3);
-  img->curve_s.resize(lanes, 0.0f);
-  img->first_frame.resize(lanes, std::numeric_limits<float>::infinity());
-  img->last_frame.resize(lanes, std::numeric_limits<float>::infinity());
-  img->first_value.resize(lanes, 0.0f);
-  img->last_value.resize(lanes, 0.0f);
-  img->curve_linear.resize(lanes, 0u);
-  img->block_count = nc == 0 ? 0 : static_cast<uint32_t>(blocks);
-  const size_t nb = img->block_curves;  // records: at most 4 per key of a block curve
-  const size_t records = size_t(img->block_count) * nb;
+  a.curve_s.resize(lanes, 0.0f);
+  a.first_frame.resize(lanes, std::numeric_limits<float>::infinity());
+  a.last_frame.resize(lanes, std::numeric_limits<float>::infinity());
+  a.first_value.resize(lanes, 0.0f);
+  a.last_value.resize(lanes, 0.0f);
+  a.curve_linear.resize(lanes, 0u);
+  a.block_count = nc == 0 ? 0 : static_cast<uint32_t>(blocks);
+  const size_t nb = a.block_curves;  // records: at most 4 per key of a block curve
+  const size_t records = size_t(a.block_count) * nb;
   std::vector<RecordPlan> plans(records);
   for (size_t i = 0; i < nb; ++i) {
-    const Curve& cv = img->curves[i];
-    const SourceChannel& sc = src.channels[img->curve_channel[i]];
+    const Curve& cv = a.curves[i];
+    const SourceChannel& sc = src.channels[a.curve_channel[i]];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
     int64_t first = 0, last = 0;  // the block's keys: [first, last)
-    for (uint32_t b = 0; b < img->block_count; ++b) {
+    for (uint32_t b = 0; b < a.block_count; ++b) {
       const int64_t start = int64_t(b) << kBlockShift;
       while (first < keys.n && int64_t(keys.k[first]) < start) ++first;
       last = std::max(last, first);
@@ -231,25 +314,25 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
   }
   // Offsets in block-major order; u32 offsets bound the payload (checked: 2^32 bytes is far
   // beyond any clip the decoder's limits admit, but a too large one must fail, not wrap).
-  img->record_offset.resize(records + kPrefetchRecords);
+  a.record_offset.resize(records + kPrefetchRecords);
   uint64_t total = 0;
   for (size_t r = 0; r < records; ++r) {
     if (total > UINT32_MAX) throw std::bad_alloc();
-    img->record_offset[r] = static_cast<uint32_t>(total);
+    a.record_offset[r] = static_cast<uint32_t>(total);
     total += plans[r].size_bytes;
   }
-  img->payload.assign(total + kPayloadPadding, 0);
+  a.payload.assign(total + kPayloadPadding, 0);
   for (size_t i = 0; i < nb; ++i) {
-    const Curve& cv = img->curves[i];
-    const SourceChannel& sc = src.channels[img->curve_channel[i]];
+    const Curve& cv = a.curves[i];
+    const SourceChannel& sc = src.channels[a.curve_channel[i]];
     const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
-    for (uint32_t b = 0; b < img->block_count; ++b) {
+    for (uint32_t b = 0; b < a.block_count; ++b) {
       const size_t r = size_t(b) * nb + i;
-      write_record(img->payload.data() + img->record_offset[r], keys, plans[r], int64_t(b) << kBlockShift,
+      write_record(a.payload.data() + a.record_offset[r], keys, plans[r], int64_t(b) << kBlockShift,
                    cv.q_base, cv.base_bits);
     }
   }
-  shrink(*img);
+  write_imag(a, *img);
   return img;
 }
 
