@@ -176,6 +176,7 @@ Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, cons
   ErrorInfo info;
   DecodeLimits limits;  // a few compressed bytes can declare many keys: --max-values bounds them too
   limits.max_keys = std::min(limits.max_keys, g.limits.max_values);
+  limits.check_content = true;  // a tool reads a runtime-profile file as thoroughly as an archive one
   const Status s = Clip::load(bytes, clip, &info, limits);
   if (s != Status::ok) {
     const int code = s == Status::unsupported_version ? kUnsupported : s == Status::limit_exceeded ? kLimit : kBadInput;

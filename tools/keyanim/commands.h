@@ -18,6 +18,7 @@ int cmd_render(const Argv& argv, Globals& g);
 int cmd_eval(const Argv& argv, Globals& g);
 int cmd_verify(const Argv& argv, Globals& g);
 int cmd_view(const Argv& argv, Globals& g);
+int cmd_convert(const Argv& argv, Globals& g);
 
 extern const char* const kEncodeHelp;
 extern const char* const kDecodeHelp;
@@ -28,5 +29,6 @@ extern const char* const kRenderHelp;
 extern const char* const kEvalHelp;
 extern const char* const kVerifyHelp;
 extern const char* const kViewHelp;
+extern const char* const kConvertHelp;
 
 }  // namespace keyanim::cli

@@ -33,6 +33,7 @@ const Command kCommands[] = {
     {"plot", cmd_plot, &kPlotHelp, Command::all, "SVG: one channel, original against reconstruction, keys marked"},
     {"render", cmd_render, &kRenderHelp, Command::all, "SVG: one frame as a stick figure, front and side view"},
     {"eval", cmd_eval, &kEvalHelp, Command::all_but_error, "compression against error for files and tolerances"},
+    {"convert", cmd_convert, &kConvertHelp, Command::none, ".kanim -> .kanim in the other profile: runtime (sampled in place) or archive"},
     {"verify", cmd_verify, &kVerifyHelp, Command::none, "check a .kanim, and its error against the original"},
     {"view", cmd_view, &kViewHelp, Command::none, "HTML page that plays a .kanim in the browser (3D skeleton)"},
 };

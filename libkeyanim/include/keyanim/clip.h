@@ -34,6 +34,11 @@ struct DecodeLimits {
   // a frame of RLE blocks makes 32768 bytes of each of its own: a 19 KB file may hold a 600 MiB
   // note, which this refuses from the section table.
   uint64_t max_note_bytes = 16ull << 20;
+  // Defaults to false. A runtime-profile file (spec/FORMAT.md section 9) is checked for its
+  // structure, which makes sampling it in place safe, and by its checksum. True also checks its
+  // content (section 9.4: the image is exactly the one its keys make), which costs about as
+  // much as loading an archive file; tools that convert or verify files set it.
+  bool check_content = false;
 };
 
 // What a channel is, independent of how a loaded clip stores it.
@@ -76,12 +81,23 @@ class Clip {
   Clip& operator=(Clip&&) noexcept;
 
   // Validates `bytes` completely (see spec/FORMAT.md, "Decoder obligations") and builds the
-  // image. On failure `out` is left empty and `err` (if given) says which section and byte
+  // image: an archive-profile file is decoded, a runtime-profile file (section 9) copied and
+  // checked (DecodeLimits::check_content says how deeply). On failure `out` is left empty and `err` (if given) says which section and byte
   // offset: the absolute offset of the offending field, or, inside a zstd-compressed section,
   // the offset of the section's stored bytes (`detail` then gives the offset within the
   // decompressed content). Reads every format version from 1.0 on.
   // With `rigs`, the clip shares the cache's rig when it holds an equal one (RigCache).
   static Status load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err = nullptr,
+                     const DecodeLimits& limits = {}, RigCache* rigs = nullptr);
+  // Samples a runtime-profile file (spec/FORMAT.md section 9) where it lies: checks it as
+  // load() does (its structure and checksum, in time proportional to its records, not its
+  // keys), then keeps pointers into `bytes` and copies nothing from them. `bytes` must start at
+  // an address that is a multiple of 8 (invalid_argument otherwise) and must stay alive and
+  // unchanged as long as the clip, its copies, or a Cursor prepared for it are used: memory
+  // mapped from a file, or an engine's asset buffer. An archive-profile file is decoded as
+  // load() does (the clip then does not use `bytes` after view() returns). The skeleton is
+  // built (or found in `rigs`) as load() does.
+  static Status view(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err = nullptr,
                      const DecodeLimits& limits = {}, RigCache* rigs = nullptr);
   // Reads the whole file, then load(). A file larger than limits.max_decompressed_bytes is
   // refused with limit_exceeded before it is read.

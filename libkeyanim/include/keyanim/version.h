@@ -8,9 +8,13 @@
 #define KEYANIM_VERSION_STRING "0.2.0"
 
 namespace keyanim {
-// What the writer writes.
+// What the writer writes: archive files as 3.0 (4.0's archive profile has 3.0's bytes, and
+// every 3.x decoder reads them), runtime-profile files as 4.0.
 inline constexpr uint16_t kFormatVersionMajor = 3;
 inline constexpr uint16_t kFormatVersionMinor = 0;
-// The loader reads every major version from this one to kFormatVersionMajor.
+inline constexpr uint16_t kRuntimeFormatVersionMajor = 4;
+inline constexpr uint16_t kRuntimeFormatVersionMinor = 0;
+// The loader reads every major version from kOldestFormatVersionMajor to kNewestFormatVersionMajor.
 inline constexpr uint16_t kOldestFormatVersionMajor = 1;
+inline constexpr uint16_t kNewestFormatVersionMajor = 4;
 }  // namespace keyanim

@@ -10,10 +10,14 @@ inline constexpr uint8_t kSignature[8] = {0x89, 'K', 'A', 'N', 0x0D, 0x0A, 0x1A,
 inline constexpr size_t kSignatureSize = 8;
 inline constexpr size_t kHeaderEnd = 24;       // signature + 16-byte header
 inline constexpr size_t kTableEntrySize = 24;  // tag, flags, stored size, raw size
-inline constexpr size_t kChecksumSize = 4;
+inline constexpr size_t kChecksumSize = 4;         // CRC-32 (the archive profile)
+inline constexpr size_t kRuntimeChecksumSize = 8;  // XXH64 (the runtime profile, section 9.1)
 
-// Header_Flags: bits 0-15 reserved (reject), bits 16-31 unused (ignore).
+// Header_Flags: bits 0-15 reserved (reject), bits 16-31 unused (ignore); from version 4, bit 0
+// is Runtime (the runtime profile, section 9).
 inline constexpr uint32_t kHeaderReservedMask = 0x0000FFFFu;
+inline constexpr uint32_t kHeaderRuntime = 1u << 0;
+inline constexpr uint16_t kRuntimeVersionMajor = 4;  // the first version with the runtime profile
 // Section_Flags.
 inline constexpr uint32_t kSectionCompressed = 1u << 0;
 inline constexpr uint32_t kSectionAncillary = 1u << 1;
@@ -30,8 +34,11 @@ inline constexpr uint32_t kTagChan = make_tag('C', 'H', 'A', 'N');
 inline constexpr uint32_t kTagKtim = make_tag('K', 'T', 'I', 'M');
 inline constexpr uint32_t kTagKval = make_tag('K', 'V', 'A', 'L');
 inline constexpr uint32_t kTagNote = make_tag('N', 'O', 'T', 'E');
-// The critical sections, in the order a file must list them.
+inline constexpr uint32_t kTagImag = make_tag('I', 'M', 'A', 'G');
+// The critical sections, in the order a file must list them: the archive profile's, and the
+// runtime profile's (entries 0 and 1 exactly, so that IMAG starts 8-aligned: section 9.1).
 inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTagKtim, kTagKval};
+inline constexpr uint32_t kRuntimeTags[3] = {kTagClip, kTagImag, kTagSkel};
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count

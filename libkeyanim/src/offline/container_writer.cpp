@@ -19,6 +19,7 @@
 #include "keyanim/version.h"
 #include "runtime/clip_access.h"
 #include "internal/clip_source.h"
+#include "offline/container_parts.h"
 
 namespace keyanim::offline {
 namespace {
@@ -89,33 +90,6 @@ std::string channel_problem(const EncodedChannel& ch, uint32_t frame_count) {
   return {};
 }
 
-std::vector<uint8_t> clip_section(const EncodedClip& clip, uint64_t keys) {
-  std::vector<uint8_t> s;
-  put_le<uint32_t>(s, clip.frame_count);
-  put_le<uint32_t>(s, static_cast<uint32_t>(clip.skeleton.joints.size()));
-  put_le<uint32_t>(s, static_cast<uint32_t>(clip.channels.size()));
-  put_le<uint8_t>(s, static_cast<uint8_t>(clip.tangent_rule));
-  put_le<uint8_t>(s, 0);   // Clip_Flags
-  put_le<uint16_t>(s, 0);  // Clip_Reserved
-  put_le<double>(s, clip.frame_time);
-  put_le<uint64_t>(s, keys);
-  return s;
-}
-
-std::vector<uint8_t> skel_section(const Skeleton& skel) {
-  std::vector<uint8_t> s;
-  for (const Joint& j : skel.joints) {
-    put_le<uint32_t>(s, static_cast<uint32_t>(j.name.size()));
-    put_bytes(s, j.name.data(), j.name.size());
-    put_le<int32_t>(s, j.parent);
-    for (double o : j.offset) put_le<double>(s, o);
-    put_le<uint8_t>(s, j.end_site ? internal::kNodeEndSite : 0);
-    put_le<uint8_t>(s, static_cast<uint8_t>(j.channels.size()));
-    for (ChannelType t : j.channels) put_le<uint8_t>(s, static_cast<uint8_t>(t));
-  }
-  return s;
-}
-
 // Column by column: values of one kind sit together and compress better.
 std::vector<uint8_t> chan_section(const std::vector<EncodedChannel>& chans, const ValuePlan& plan) {
   std::vector<uint8_t> s;
@@ -157,13 +131,6 @@ std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans, cons
   }
   return s;
 }
-
-struct Section {
-  uint32_t tag = 0;
-  uint32_t flags = 0;
-  uint64_t raw_size = 0;
-  std::vector<uint8_t> stored;
-};
 
 // zstd's parameters for one section: a level, and a minimum match length (0: the level's).
 struct Zstd {
@@ -277,6 +244,56 @@ std::string first_broken_rule(const EncodedClip& clip) {
 
 }  // namespace
 
+
+std::vector<uint8_t> clip_section(uint32_t frame_count, const Skeleton& skeleton, size_t channels, TangentRule rule,
+                                  double frame_time, uint64_t keys) {
+  // Section 4.1's fields at their offsets (little-endian hosts, as the loader assumes).
+  std::vector<uint8_t> s(internal::kClipSize, 0);
+  const uint32_t counts[3] = {frame_count, static_cast<uint32_t>(skeleton.joints.size()), static_cast<uint32_t>(channels)};
+  std::memcpy(s.data(), counts, sizeof counts);
+  s[12] = static_cast<uint8_t>(rule);  // then Clip_Flags and Clip_Reserved, 0
+  std::memcpy(s.data() + 16, &frame_time, 8);
+  std::memcpy(s.data() + 24, &keys, 8);
+  return s;
+}
+
+std::vector<uint8_t> skel_section(const Skeleton& skel) {
+  std::vector<uint8_t> s;
+  for (const Joint& j : skel.joints) {
+    put_le<uint32_t>(s, static_cast<uint32_t>(j.name.size()));
+    put_bytes(s, j.name.data(), j.name.size());
+    put_le<int32_t>(s, j.parent);
+    for (double o : j.offset) put_le<double>(s, o);
+    put_le<uint8_t>(s, j.end_site ? internal::kNodeEndSite : 0);
+    put_le<uint8_t>(s, static_cast<uint8_t>(j.channels.size()));
+    for (ChannelType t : j.channels) put_le<uint8_t>(s, static_cast<uint8_t>(t));
+  }
+  return s;
+}
+
+std::vector<uint8_t> assemble(const std::vector<Section>& sections, uint16_t major, uint16_t minor, uint32_t flags,
+                              size_t checksum_size) {
+  size_t total = internal::kHeaderEnd + internal::kTableEntrySize * sections.size() + checksum_size;
+  for (const auto& s : sections) total += s.stored.size();
+  // Signature and header (section 2) at their offsets: put_le on an empty vector here made
+  // GCC 12 warn of an overflow that cannot happen.
+  std::vector<uint8_t> out(internal::kHeaderEnd, 0);
+  out.reserve(total);
+  std::memcpy(out.data(), internal::kSignature, internal::kSignatureSize);
+  const uint16_t version[2] = {major, minor};
+  const uint32_t header[2] = {flags, static_cast<uint32_t>(sections.size())};  // then Header_Reserved, 0
+  std::memcpy(out.data() + 8, version, sizeof version);
+  std::memcpy(out.data() + 12, header, sizeof header);
+  for (const auto& s : sections) {
+    put_le<uint32_t>(out, s.tag);
+    put_le<uint32_t>(out, s.flags);
+    put_le<uint64_t>(out, s.stored.size());
+    put_le<uint64_t>(out, s.raw_size);
+  }
+  for (const auto& s : sections) put_bytes(out, s.stored.data(), s.stored.size());
+  return out;
+}
+
 void validate_encoded_clip(const EncodedClip& clip) {
   if (std::string rule = first_broken_rule(clip); !rule.empty()) throw Error(ErrorKind::invalid_argument, rule);
 }
@@ -300,7 +317,7 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zst
   auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes, Zstd z) {
     raw.push_back({tag, flags, std::move(bytes), z, {}});
   };
-  add(internal::kTagClip, 0, clip_section(clip, keys), Zstd{});  // 32 bytes: stored raw
+  add(internal::kTagClip, 0, clip_section(clip.frame_count, clip.skeleton, clip.channels.size(), clip.tangent_rule, clip.frame_time, keys), Zstd{});  // 32 bytes: stored raw
   add(internal::kTagSkel, 0, skel_section(clip.skeleton), zstd(kSkelZstd));
   const ValuePlan plan = plan_values(clip.channels);
   add(internal::kTagChan, 0, chan_section(clip.channels, plan), zstd(kChanZstd));
@@ -325,23 +342,7 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zst
   }
   ZSTD_freeCCtx(cctx);
 
-  std::vector<uint8_t> out;
-  size_t total = internal::kHeaderEnd + internal::kTableEntrySize * sections.size() + internal::kChecksumSize;
-  for (const auto& s : sections) total += s.stored.size();
-  out.reserve(total);
-  put_bytes(out, internal::kSignature, internal::kSignatureSize);
-  put_le<uint16_t>(out, kFormatVersionMajor);
-  put_le<uint16_t>(out, kFormatVersionMinor);
-  put_le<uint32_t>(out, 0);  // Header_Flags
-  put_le<uint32_t>(out, static_cast<uint32_t>(sections.size()));
-  put_le<uint32_t>(out, 0);  // Header_Reserved
-  for (const auto& s : sections) {
-    put_le<uint32_t>(out, s.tag);
-    put_le<uint32_t>(out, s.flags);
-    put_le<uint64_t>(out, s.stored.size());
-    put_le<uint64_t>(out, s.raw_size);
-  }
-  for (const auto& s : sections) put_bytes(out, s.stored.data(), s.stored.size());
+  std::vector<uint8_t> out = assemble(sections, kFormatVersionMajor, kFormatVersionMinor, 0, internal::kChecksumSize);
   put_le<uint32_t>(out, crc32_of(out.data(), out.size()));
   return out;
 }

@@ -22,6 +22,7 @@
 //   Values        n x w         q - q_base - Base of the window's n = popcount(Mask) + 4 keys,
 //                               in frame order: two before, the block's keys, two after
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -47,6 +48,8 @@ inline constexpr uint32_t kBlockFrames = 1u << kBlockShift;
 inline constexpr uint32_t kRecordBitsAt = 80;  // Context starts after Mask, Value_Bits, Context_Bits
 inline constexpr uint32_t kContextKeys = 4;
 inline constexpr uint32_t kNoCurve = UINT32_MAX;
+inline constexpr uint32_t kMaxValueBits = 55;    // Value_Bits and Base_Bits (spec 9.3)
+inline constexpr uint32_t kMaxContextBits = 31;  // Context_Bits
 inline constexpr uint32_t kPrefetchRecords = kImageTailEntries;  // see Image::record_offset
 // so that an 8-byte load at any record bit is in bounds
 inline constexpr size_t kPayloadPadding = kImageTailEntries;
@@ -57,7 +60,9 @@ struct Curve {
   int64_t q_base = 0;    // smallest q of the curve
   double step = 1.0;
   uint32_t base_bits = 0;  // wc
+  uint32_t reserved = 0;   // IMAG's Curve_Reserved
 };
+static_assert(sizeof(Curve) == kCurveBytes && offsetof(Curve, base_bits) == 16, "IMAG's Curves entry (spec 9.2)");
 
 // A list curve's keys: Image::list_frames/list_values[first .. first + count).
 struct ListSpan {
@@ -132,6 +137,17 @@ void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) 
 // Builds the image of a valid source (its keys decoded, every rule checked). With `rigs`, the
 // skeleton is the cache's rig when it holds an equal one (rig.h).
 std::shared_ptr<const Image> build_image(ClipSource&& source, RigCache* rigs = nullptr);
+// The image of a runtime-profile file whose IMAG passed the structure checks (load/): `facts`
+// holds its CLIP, SKEL and NOTE (no keys), `imag` points into `storage` (or into caller-owned
+// bytes when `storage` is null: Clip::view).
+std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys, std::span<const uint8_t> imag,
+                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs);
+// The keys `img` holds (spec section 9.3), as a source (image_keys.cpp). A single key comes back
+// as q = +-1 and step = |value| (the image keeps only its value): the same key, bit for bit.
+ClipSource image_keys(const Image& img);
+// Section 9.4's content rules: every q within 2^53 and every value finite, and IMAG exactly the
+// image built from the keys it holds.
+bool image_content_holds(const Image& img);
 // Whether a curve of n keys over `blocks` blocks is kept as a list (see Image::curves).
 inline bool is_list_curve(uint64_t n, uint64_t blocks) noexcept { return 4 * n < blocks; }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <utility>
@@ -146,7 +147,12 @@ void write_imag(const Arrays& a, Image& img) {
   put_array(imag, at, L::fixed_value, a.fixed_value);
   put_array(imag, at, L::fixed_frame, a.fixed_frame);
   put_array(imag, at, L::fixed_channels, a.fixed_channels);
-  put_array(imag, at, L::curves, a.curves);
+  for (size_t i = 0; i < a.curves.size(); ++i) {  // field by field: a Curve's padding is not zero
+    uint8_t* p = imag + at.at[L::curves] + size_t(kCurveBytes) * i;
+    std::memcpy(p, &a.curves[i].q_base, 8);
+    std::memcpy(p + 8, &a.curves[i].step, 8);
+    std::memcpy(p + 16, &a.curves[i].base_bits, 4);  // then Curve_Reserved, 0
+  }
   put_array(imag, at, L::curve_s, a.curve_s);
   put_array(imag, at, L::first_frame, a.first_frame);
   put_array(imag, at, L::last_frame, a.last_frame);
@@ -216,19 +222,11 @@ void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) 
   img.payload = array_at<uint8_t>(imag, at, L::payload, n.payload + kPayloadPadding);
 }
 
-std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
-  auto img = std::make_shared<Image>();
-  img->version_major = src.version_major;
-  img->version_minor = src.version_minor;
-  img->frame_count = src.frame_count;
-  img->frame_time = src.frame_time;
-  img->rule = src.rule;
-  img->rig = rigs != nullptr ? RigCacheAccess::intern(*rigs, std::move(src.skeleton)) : make_rig(std::move(src.skeleton));
-  img->notes = std::move(src.notes);
-  img->total_keys = src.frames.size();
-  static std::atomic<uint64_t> next_id{1};
-  img->id = next_id.fetch_add(1, std::memory_order_relaxed);
+namespace {
 
+// The image's arrays from a source's keys: two passes over every curve, the first sizing each
+// record (its widths depend on the values in its window), the second writing it at its place.
+Arrays build_arrays(const ClipSource& src) {
   Arrays a;
   const size_t channels = src.channels.size();
   a.interp.resize(channels);
@@ -332,8 +330,56 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
                    cv.q_base, cv.base_bits);
     }
   }
+  return a;
+}
+
+// The clip's facts, rig and notes (not its arrays), from a source or a checked file.
+std::shared_ptr<Image> image_of(ClipSource& src, RigCache* rigs) {
+  auto img = std::make_shared<Image>();
+  img->version_major = src.version_major;
+  img->version_minor = src.version_minor;
+  img->frame_count = src.frame_count;
+  img->frame_time = src.frame_time;
+  img->rule = src.rule;
+  img->rig = rigs != nullptr ? RigCacheAccess::intern(*rigs, std::move(src.skeleton)) : make_rig(std::move(src.skeleton));
+  img->notes = std::move(src.notes);
+  static std::atomic<uint64_t> next_id{1};
+  img->id = next_id.fetch_add(1, std::memory_order_relaxed);
+  return img;
+}
+
+}  // namespace
+
+std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
+  const Arrays a = build_arrays(src);
+  const uint64_t keys = src.frames.size();
+  std::shared_ptr<Image> img = image_of(src, rigs);
+  img->total_keys = keys;
   write_imag(a, *img);
   return img;
+}
+
+std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys, std::span<const uint8_t> imag,
+                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs) {
+  const uint32_t channels = static_cast<uint32_t>(facts.skeleton.channel_count());
+  std::shared_ptr<Image> img = image_of(facts, rigs);
+  img->total_keys = total_keys;
+  img->storage = std::move(storage);
+  img->held_bytes = held_bytes;
+  attach_image(*img, imag, channels);
+  return img;
+}
+
+bool image_content_holds(const Image& img) {
+  ClipSource keys = image_keys(img);
+  for (size_t c = 0; c < keys.channels.size(); ++c) {
+    const SourceChannel& sc = keys.channels[c];
+    for (uint64_t i = sc.first_key; i < sc.first_key + sc.key_count; ++i)
+      if (keys.q[i] > kMaxAbsQ || keys.q[i] < -kMaxAbsQ || !std::isfinite(dequantize(keys.q[i], sc.step))) return false;
+  }
+  Image rebuilt;
+  write_imag(build_arrays(keys), rebuilt);
+  return rebuilt.imag.size() == img.imag.size() && std::memcmp(rebuilt.imag.data(), img.imag.data(), img.imag.size()) == 0;
 }
 
 }  // namespace keyanim::internal

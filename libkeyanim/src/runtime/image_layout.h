@@ -30,21 +30,22 @@ struct ImageLayout {
     list_frames, list_values, list_q, record_offset, payload, kArrays
   };
   uint64_t at[kArrays + 1];  // at[kArrays] is the end
-  uint64_t size(Array a) const noexcept { return at[a + 1] - at[a]; }  // with its padding
+  uint64_t used[kArrays];    // each array's bytes without its padding
   uint64_t end() const noexcept { return at[kArrays]; }
 
   static uint64_t pad8(uint64_t n) noexcept { return (n + 7) & ~uint64_t(7); }
   static uint64_t lanes(uint64_t curves) noexcept { return (curves + 3) & ~uint64_t(3); }
 
+  // Needs curves <= channels and block_curves <= curves.
   explicit ImageLayout(const ImageCounts& n) noexcept {
     const uint64_t c = n.channels, l = lanes(n.curves);
-    const uint64_t bytes[kArrays] = {
+    const uint64_t bytes[kArrays] = {  // section 9.2's table, row by row
         c,     4 * c, 4 * c,                    4 * c,  4 * c,  4 * c,  4 * (c - n.curves), kCurveBytes * n.curves,
         4 * l, 4 * l, 4 * l,                    4 * l,  4 * l,  4 * l,  4 * n.curves,       8 * (n.curves - n.block_curves),
         4 * n.list_keys, 4 * n.list_keys, 8 * n.list_keys,
         4 * (n.blocks * n.block_curves + kImageTailEntries), n.payload + kImageTailEntries};
     at[0] = kImageHeaderBytes;
-    for (uint32_t a = 0; a < kArrays; ++a) at[a + 1] = at[a] + pad8(bytes[a]);
+    for (uint32_t a = 0; a < kArrays; ++a) used[a] = bytes[a], at[a + 1] = at[a] + pad8(bytes[a]);
   }
 };
 

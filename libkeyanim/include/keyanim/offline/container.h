@@ -24,6 +24,14 @@ void validate_encoded_clip(const EncodedClip& clip);
 // zstd context at a time (memory). Throws as validate_encoded_clip(clip).
 std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level = std::nullopt);
 
+// The runtime profile of a loaded clip (spec/FORMAT.md section 9, version 4.0): its image as
+// the file's bytes, which Clip::view samples in place. It samples to the same values, bit for
+// bit, as the file it was loaded from.
+std::vector<uint8_t> write_kanim_runtime(const Clip& clip);
+// A loaded clip's keys as write_kanim takes them: from a runtime-profile file back to the
+// archive profile. The same keys, frames and values bit for bit; a channel with a single key
+// comes back as q = +-1 and step = |value|, since a clip keeps only that key's value.
+EncodedClip encoded_clip(const Clip& clip);
 // The clip a decoder builds from write_kanim(clip), without the bytes: the encoder verifies
 // its error on this. Its arrays are identical to those Clip::load builds from the file.
 // `clip` must be valid (validate_encoded_clip).

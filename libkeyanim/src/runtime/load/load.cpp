@@ -1,6 +1,8 @@
 // Loading a .kanim file: the loader's parts (load/) in the order of spec/FORMAT.md section 7,
 // then the image the sampler reads (image_build.cpp). Clip::load and Clip::load_file.
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <string>
@@ -20,6 +22,7 @@ Status Loader::run(ClipSource& parts) {
   if (s != Status::ok) return s;
   parts.version_major = major_;
   parts.version_minor = minor_;
+  if (runtime_) return run_runtime(parts);
   // Sections in table order (the critical ones are in order by now); unknown ancillary
   // sections are skipped without being decompressed.
   for (size_t i = 0; i < table_.size(); ++i) {
@@ -49,10 +52,55 @@ Status Loader::run(ClipSource& parts) {
   return Status::ok;
 }
 
+// CLIP, IMAG, SKEL (entries 0, 1 and a later one, uncompressed), and NOTE.
+Status Loader::run_runtime(ClipSource& parts) {
+  Content c;
+  Status s = get_content(table_[0], "CLIP", c);
+  if (s == Status::ok) s = parse_clip(c, parts);
+  if (s == Status::ok) s = get_content(table_[1], "IMAG", imag_);
+  if (s == Status::ok) s = check_image(imag_, parts);
+  if (s == Status::ok) s = get_content(table_[static_cast<size_t>(critical_index_[2])], "SKEL", c);
+  if (s == Status::ok) s = parse_skel(c, parts);
+  if (s == Status::ok && note_index_ >= 0) {
+    s = get_content(table_[static_cast<size_t>(note_index_)], "NOTE", c);
+    if (s == Status::ok) parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);
+  }
+  return s;
+}
+
 }  // namespace internal
 
 using internal::ClipSource;
 using internal::Loader;
+
+namespace {
+
+Status out_of_memory(Clip& out, ErrorInfo* err) {
+  out = Clip{};
+  if (err != nullptr) *err = ErrorInfo{Status::limit_exceeded, 0, "file", "out of memory"};
+  return Status::limit_exceeded;
+}
+
+// A runtime-profile file whose structure passed: its image over `bytes` (which `storage` owns,
+// or the caller), then the content rules if asked for.
+Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t> bytes,
+                    std::shared_ptr<const void> storage, const DecodeLimits& limits, RigCache* rigs, Clip& out,
+                    ErrorInfo* err) {
+  const uint64_t keys = loader.key_count();
+  const std::span<const uint8_t> imag = loader.image();
+  out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage),
+                                              storage ? bytes.size() : 0, rigs));
+  if (limits.check_content && !internal::image_content_holds(ClipAccess::image(out))) {
+    out = Clip{};
+    if (err != nullptr)
+      *err = ErrorInfo{Status::corrupt, static_cast<uint64_t>(imag.data() - bytes.data()), "IMAG",
+                       "the image is not the one its keys make (spec section 9.4, content rules)"};
+    return Status::corrupt;
+  }
+  return Status::ok;
+}
+
+}  // namespace
 
 Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits,
                   RigCache* rigs) {
@@ -63,18 +111,46 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
     Loader loader(bytes, limits, err);
     const Status s = loader.run(parts);
     if (s != Status::ok) return s;
-    out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
-  } catch (const std::bad_alloc&) {
-    out = Clip{};
-    if (err != nullptr) {
-      err->status = Status::limit_exceeded;
-      err->section = "file";
-      err->byte_offset = 0;
-      err->detail = "out of memory";
+    if (!loader.runtime()) {
+      out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
+      return Status::ok;
     }
-    return Status::limit_exceeded;
+    // The runtime profile: the file's bytes copied to 8-aligned memory the clip owns, and
+    // viewed there (checked again: cheap, and the spans must point into the copy).
+    auto words = std::shared_ptr<uint64_t[]>(new uint64_t[(bytes.size() + 7) / 8]);
+    std::memcpy(words.get(), bytes.data(), bytes.size());
+    const std::span<const uint8_t> copy(reinterpret_cast<const uint8_t*>(words.get()), bytes.size());
+    ClipSource facts;
+    Loader again(copy, limits, err);
+    if (const Status c = again.run(facts); c != Status::ok) return c;
+    return runtime_clip(again, std::move(facts), copy, std::move(words), limits, rigs, out, err);
+  } catch (const std::bad_alloc&) {
+    return out_of_memory(out, err);
   }
-  return Status::ok;
+}
+
+Status Clip::view(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits,
+                  RigCache* rigs) {
+  out = Clip{};
+  if (err != nullptr) *err = ErrorInfo{};
+  if (reinterpret_cast<uintptr_t>(bytes.data()) % 8 != 0) {
+    if (err != nullptr)
+      *err = ErrorInfo{Status::invalid_argument, 0, "file", "Clip::view needs the bytes at an address that is a multiple of 8"};
+    return Status::invalid_argument;
+  }
+  try {
+    ClipSource parts;
+    Loader loader(bytes, limits, err);
+    const Status s = loader.run(parts);
+    if (s != Status::ok) return s;
+    if (!loader.runtime()) {  // an archive file is decoded: the clip then needs `bytes` no more
+      out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
+      return Status::ok;
+    }
+    return runtime_clip(loader, std::move(parts), bytes, nullptr, limits, rigs, out, err);
+  } catch (const std::bad_alloc&) {
+    return out_of_memory(out, err);
+  }
 }
 
 Status Clip::load_file(const std::string& path, Clip& out, ErrorInfo* err, const DecodeLimits& limits,

@@ -14,6 +14,7 @@
 #include "internal/clip_source.h"
 #include "internal/value_coding.h"
 #include "keyanim/clip.h"
+#include "runtime/image_layout.h"
 
 namespace keyanim::internal {
 
@@ -47,7 +48,12 @@ class Loader {
   Loader(std::span<const uint8_t> bytes, const DecodeLimits& limits, ErrorInfo* err)
       : bytes_(bytes), limits_(limits), err_(err) {}
 
+  // The archive profile: every section into `parts`. The runtime profile: CLIP, SKEL and NOTE
+  // into `parts` (no keys), IMAG checked (section 9.4's structure rules) and left in image().
   Status run(ClipSource& parts);  // load.cpp
+  bool runtime() const noexcept { return runtime_; }
+  uint64_t key_count() const noexcept { return key_count_; }
+  std::span<const uint8_t> image() const noexcept { return {imag_.data, imag_.size}; }
 
  private:
   Status fail(Status s, const char* section, uint64_t offset, std::string detail) {
@@ -89,6 +95,11 @@ class Loader {
   Status parse_ktim(const Content& c, ClipSource& parts);
   Status parse_kval(const Content& c, ClipSource& parts);        // 1.x and 2.x: varint planes
   Status parse_kval_fixed(const Content& c, ClipSource& parts);  // 3.x: fixed-width byte planes
+  // IMAG (image_check.cpp): the header, the channels, then the curves and lists, then the records.
+  Status check_image(const Content& c, const ClipSource& parts);
+  Status check_image_curves(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
+  Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
+  Status run_runtime(ClipSource& parts);  // run() for the runtime profile
   // Turns channel ch's residual r (of key i, found at section offset at) into q, checking the
   // bounds of section 4.5; q and q_prev carry the previous two.
   Status residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i, uint64_t zigzag, int64_t& q,
@@ -100,8 +111,10 @@ class Loader {
 
   uint16_t major_ = 0;
   uint16_t minor_ = 0;
+  bool runtime_ = false;  // the runtime profile (Header_Flags bit 0, version 4)
+  Content imag_;          // its IMAG, once checked
   std::vector<TableEntry> table_;
-  int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL
+  int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL (runtime: CLIP, IMAG, SKEL)
   int note_index_ = -1;
   std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx_;
   // Decompressed sections, alive until parsed. Not zero-filled: a small file declaring a large

@@ -10,6 +10,7 @@
 #include "internal/byte_reader.h"
 #include "internal/format.h"
 #include "internal/varint.h"
+#include "internal/xxh64.h"
 #include "internal/zstd_bound.h"
 #include "keyanim/version.h"
 #include "runtime/load/loader.h"
@@ -43,19 +44,23 @@ Status Loader::read_header_and_table() {
   r.read(header_flags);
   r.read(section_count);
   r.read(reserved);
-  if (major < kOldestFormatVersionMajor || major > kFormatVersionMajor)
+  if (major < kOldestFormatVersionMajor || major > kNewestFormatVersionMajor)
     return fail(Status::unsupported_version, "header", 8,
                 "major version " + std::to_string(major) + " (this decoder reads versions " +
-                    std::to_string(kOldestFormatVersionMajor) + " to " + std::to_string(kFormatVersionMajor) + ")");
+                    std::to_string(kOldestFormatVersionMajor) + " to " + std::to_string(kNewestFormatVersionMajor) + ")");
   major_ = major;
-  if (header_flags & internal::kHeaderReservedMask)
+  runtime_ = major >= internal::kRuntimeVersionMajor && (header_flags & internal::kHeaderRuntime) != 0;
+  if (header_flags & internal::kHeaderReservedMask & ~(major >= internal::kRuntimeVersionMajor ? internal::kHeaderRuntime : 0u))
     return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
   if (reserved != 0) return fail(Status::reserved_bits_set, "header", 20, "Header_Reserved is not 0");
 
-  // The table and the checksum must fit: 24 * count + 4 <= size - 24, in subtraction form.
+  // The table and the checksum must fit: 24 * count + 4 (8) <= size - 24, in subtraction form.
   const size_t avail = size - internal::kHeaderEnd;
-  if (avail < internal::kChecksumSize ||
-      section_count > (avail - internal::kChecksumSize) / internal::kTableEntrySize)
+  const size_t checksum_size = runtime_ ? internal::kRuntimeChecksumSize : internal::kChecksumSize;
+  const uint32_t* critical_tags = runtime_ ? internal::kRuntimeTags : internal::kCriticalTags;
+  const size_t critical_count = runtime_ ? 3 : 5;
+  if (avail < checksum_size ||
+      section_count > (avail - checksum_size) / internal::kTableEntrySize)
     return fail(Status::truncated, "table", size,
                 "the file ends inside the section table of " + std::to_string(section_count) + " entries");
   table_.resize(section_count);  // bounded by the file size just checked
@@ -73,14 +78,20 @@ Status Loader::read_header_and_table() {
     if (e.flags & internal::kSectionReservedMask)
       return fail(Status::reserved_bits_set, "table", e.entry_offset + 4, name + ": reserved Section_Flags bits are set");
     const bool ancillary = (e.flags & internal::kSectionAncillary) != 0;
-    size_t crit = 5;
-    for (size_t k = 0; k < 5; ++k)
-      if (internal::kCriticalTags[k] == e.tag) crit = k;
-    if (crit < 5) {
+    size_t crit = critical_count;
+    for (size_t k = 0; k < critical_count; ++k)
+      if (critical_tags[k] == e.tag) crit = k;
+    if (runtime_ && (e.flags & internal::kSectionCompressed))
+      return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": no section of the runtime profile is compressed");
+    if (runtime_ && crit == critical_count && !ancillary && e.tag != internal::kTagNote)
+      for (uint32_t tag : internal::kCriticalTags)
+        if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
+    if (crit < critical_count) {
       if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
-      if (crit != next_critical)
+      if (crit != next_critical || (runtime_ && crit < 2 && i != crit))
         return fail(Status::corrupt, "table", e.entry_offset,
-                    name + ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order");
+                    name + (runtime_ ? ": the runtime profile's sections must be CLIP (entry 0), IMAG (entry 1), SKEL, once each"
+                                     : ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order"));
       critical_index_[crit] = static_cast<int>(i);
       ++next_critical;
     } else if (e.tag == internal::kTagNote) {
@@ -97,13 +108,13 @@ Status Loader::read_header_and_table() {
       return fail(Status::truncated, "table", size, name + ": the file ends before the section's declared end");
     pos += e.stored;
   }
-  if (next_critical != 5)
+  if (next_critical != critical_count)
     return fail(Status::corrupt, "table", internal::kHeaderEnd,
-                std::string("missing critical section ") + tag_name(internal::kCriticalTags[next_critical]));
-  if (size - pos < internal::kChecksumSize) return fail(Status::truncated, "checksum", size, "the file ends inside the checksum");
-  if (size - pos > internal::kChecksumSize)
-    return fail(Status::trailing_bytes, "checksum", pos + internal::kChecksumSize,
-                std::to_string(size - pos - internal::kChecksumSize) + " bytes after the checksum");
+                std::string("missing critical section ") + tag_name(critical_tags[next_critical]));
+  if (size - pos < checksum_size) return fail(Status::truncated, "checksum", size, "the file ends inside the checksum");
+  if (size - pos > checksum_size)
+    return fail(Status::trailing_bytes, "checksum", pos + checksum_size,
+                std::to_string(size - pos - checksum_size) + " bytes after the checksum");
 
   // Everything this decoder will decompress or copy, before anything is.
   uint64_t raw_total = 0;
@@ -122,6 +133,11 @@ Status Loader::read_header_and_table() {
   }
   if (Status s = check_expansion(); s != Status::ok) return s;
 
+  if (runtime_) {
+    if (internal::xxh64_of(p, pos) != internal::load_le<uint64_t>(p + pos))
+      return fail(Status::checksum_mismatch, "checksum", pos, "XXH64 of the file does not match its checksum");
+    return Status::ok;
+  }
   uLong crc = crc32(0L, Z_NULL, 0);
   for (uint64_t done = 0; done < pos;) {
     const uInt chunk = static_cast<uInt>(std::min<uint64_t>(pos - done, 1u << 30));

@@ -1,0 +1,84 @@
+// The keys an image holds (spec/FORMAT.md section 9.3, "The keys of a curve"), as the integers
+// a file stores: for the runtime profile's content check (rebuild and compare) and for
+// converting a runtime-profile clip back to the archive profile.
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "runtime/image.h"
+
+namespace keyanim::internal {
+namespace {
+
+// A single key's value as q x step, exactly: the image keeps only the value of a channel's
+// single key, and any (q, step) that dequantizes to it bit for bit is that key.
+void single_key(float v, int64_t& q, double& step) noexcept {
+  if (v == 0.0f) {
+    q = std::signbit(v) ? -1 : 0;  // -0.0: -1 x the smallest step rounds to -0.0
+    step = std::signbit(v) ? std::numeric_limits<double>::denorm_min() : 1.0;
+    return;
+  }
+  q = v > 0.0f ? 1 : -1;
+  step = std::fabs(static_cast<double>(v));
+}
+
+void block_curve_keys(const Image& img, uint32_t curve, ClipSource& out) {
+  const Curve& cv = img.curves[curve];
+  for (uint32_t b = 0; b < img.block_count; ++b) {
+    const uint8_t* rec = img.record(b, curve);
+    uint64_t mask;
+    std::memcpy(&mask, rec, 8);
+    const uint32_t vw = rec[8], kw = rec[9];
+    const uint64_t base_at = kRecordBitsAt + uint64_t(kContextKeys) * kw;
+    const int64_t low = cv.q_base + static_cast<int64_t>(read_bits(rec, base_at, cv.base_bits));
+    uint64_t at = base_at + cv.base_bits + 2ull * vw;  // Values[2]: the block's first key
+    for (; mask != 0; mask &= mask - 1, at += vw) {
+      out.frames.push_back((b << kBlockShift) + static_cast<uint32_t>(low_bit(mask)));
+      out.q.push_back(low + static_cast<int64_t>(read_bits(rec, at, vw)));
+    }
+  }
+}
+
+}  // namespace
+
+ClipSource image_keys(const Image& img) {
+  ClipSource src;
+  src.version_major = img.version_major;
+  src.version_minor = img.version_minor;
+  src.frame_count = img.frame_count;
+  src.frame_time = img.frame_time;
+  src.rule = img.rule;
+  src.skeleton = img.rig->skeleton;
+  src.notes = img.notes;
+  src.channels.resize(img.interp.size());
+  src.frames.reserve(static_cast<size_t>(img.total_keys));
+  src.q.reserve(static_cast<size_t>(img.total_keys));
+  for (size_t c = 0; c < img.interp.size(); ++c) {
+    SourceChannel& sc = src.channels[c];
+    sc.interp = img.interp[c];
+    sc.tension = img.tension[c];
+    sc.first_key = src.frames.size();
+    sc.key_count = img.key_count[c];
+    const uint32_t curve = img.curve_of[c];
+    if (curve == kNoCurve) {
+      if (sc.key_count == 1) {
+        int64_t q;
+        single_key(img.fixed_value[c], q, sc.step);
+        src.frames.push_back(img.fixed_frame[c]);
+        src.q.push_back(q);
+      }
+      continue;
+    }
+    sc.step = img.curves[curve].step;
+    if (curve < img.block_curves) {
+      block_curve_keys(img, curve, src);
+    } else {
+      const ListSpan list = img.lists[curve - img.block_curves];
+      src.frames.insert(src.frames.end(), img.list_frames.begin() + list.first, img.list_frames.begin() + list.first + list.count);
+      src.q.insert(src.q.end(), img.list_q.begin() + list.first, img.list_q.begin() + list.first + list.count);
+    }
+  }
+  return src;
+}
+
+}  // namespace keyanim::internal
