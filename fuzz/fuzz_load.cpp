@@ -32,7 +32,7 @@ keyanim::DecodeLimits fuzz_limits() {
 }
 
 void check_loaded(const Clip& clip) {
-  FUZZ_CHECK(clip.version_major() >= keyanim::kOldestFormatVersionMajor && clip.version_major() <= keyanim::kFormatVersionMajor);
+  FUZZ_CHECK(clip.version_major() >= keyanim::kOldestFormatVersionMajor && clip.version_major() <= keyanim::kNewestFormatVersionMajor);
   const uint32_t channels = clip.channel_count();
   FUZZ_CHECK(clip.skeleton().channel_count() == channels);
   FUZZ_CHECK(std::isfinite(clip.frame_time()) && clip.frame_time() >= 0.0);

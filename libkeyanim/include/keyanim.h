@@ -193,6 +193,25 @@ KEYANIM_C_API uint64_t keyanim_rig_cache_rig_count(const keyanim_rig_cache* rigs
 KEYANIM_C_API keyanim_status keyanim_clip_load_shared(const uint8_t* bytes, size_t size,
                                                       const keyanim_decode_limits* limits,
                                                       keyanim_rig_cache* rigs, keyanim_clip** out);
+/* ---- The runtime profile: a file sampled where it lies (spec/FORMAT.md section 9) ----------- */
+
+/* Like keyanim_clip_load_limited (limits NULL: the defaults; rigs NULL: none, else through that
+ * cache), but a runtime-profile file is not copied: the clip samples `bytes` in place, after
+ * checking its structure and checksum (in time proportional to its records, not its keys).
+ * `bytes` must be at an address that is a multiple of 8 (else KEYANIM_INVALID_ARGUMENT) and must
+ * stay alive and unchanged until the clip and every cursor made for it are freed: memory mapped
+ * from a file, or an engine's asset buffer. An archive-profile file is decoded as by
+ * keyanim_clip_load (the clip then does not use `bytes` after the call). */
+KEYANIM_C_API keyanim_status keyanim_clip_view(const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
+                                               keyanim_rig_cache* rigs, keyanim_clip** out);
+/* 1 when the clip's file was of the runtime profile, else 0 (also for NULL). */
+KEYANIM_C_API int32_t keyanim_clip_runtime_profile(const keyanim_clip* clip);
+/* A runtime-profile clip's content rules (section 9.4: its image is exactly the one its keys
+ * make), which loading and viewing do not check; KEYANIM_OK, or KEYANIM_CORRUPT. Costs about
+ * an archive file's load: for tools that convert or verify files. KEYANIM_OK for a clip of the
+ * archive profile (built from its keys). */
+KEYANIM_C_API keyanim_status keyanim_clip_check_content(const keyanim_clip* clip);
+
 /* 64-bit FNV-1a of the rig (each node's name, parent, offset bits, End Site flag and channel
  * list, in node order): equal for clips of one skeleton (0 for NULL). */
 KEYANIM_C_API uint64_t keyanim_clip_rig_hash(const keyanim_clip* clip);

@@ -325,7 +325,7 @@ TEST_CASE("test vectors: versions") {
     INFO(path.filename().string());
     std::vector<uint8_t> f = read_bytes(path);
     const uint8_t major = f[8];
-    f[8] = uint8_t(keyanim::kFormatVersionMajor + 1);  // a later major: refused whatever the checksum says
+    f[8] = uint8_t(keyanim::kNewestFormatVersionMajor + 1);  // a later major: refused whatever the checksum says
     CHECK(load_fails(f) == Status::unsupported_version);
     fix_checksum(f);
     CHECK(load_fails(f) == Status::unsupported_version);

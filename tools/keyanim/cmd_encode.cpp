@@ -23,7 +23,7 @@ namespace keyanim::cli {
 
 const char* const kEncodeHelp =
     "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--to kanim] [--error E|E%] [--shell D|D%]\n"
-    "                      [--keys MODE] [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
+    "                      [--keys MODE] [--tension T|fit] [--level N] [--runtime] [-j N] [--json] [-f]\n"
     "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
     "                      [--report R.jsonl] [--error E|E%] [--shell D|D%] [--keys MODE] [-j N] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode): every joint,\n"
@@ -44,6 +44,9 @@ const char* const kEncodeHelp =
     "  --skip-existing       skip an input whose output exists and loads as a valid file\n"
     "  --report R.jsonl      append one JSON line per finished input: input, output, status\n"
     "                        (ok, skipped, failed), bytes, max_error, tolerance, seconds\n"
+    "  --runtime             write the runtime profile (format 4.0): the image a player samples\n"
+    "                        where it lies, loaded with no decoding, about 1.8x the archive's\n"
+    "                        bytes (`keyanim convert` turns either profile into the other)\n"
     "  --json                one JSON object on standard output (not with -o -); names that\n"
     "                        are not UTF-8 keep their bytes as \\udcHH escapes\n";
 
@@ -51,7 +54,7 @@ const char* const kEncodeHelp =
 // the input); the output is written only when everything else has succeeded. Memory: the BVH
 // text goes once parsed, the motion's values once encoded. With `bar`, the stages show on it.
 Encoded encode_one(const std::string& in, const std::string& out, offline::EncodeSettings settings,
-                   bool error_given, bool to_given, const Globals& g, Progress* bar) {
+                   bool error_given, bool to_given, bool runtime, const Globals& g, Progress* bar) {
   Input input(in, g);
   Output output(out, true, g, ids_of({&input}), kanim_format(to_given));
   EncodeProgress progress(bar, settings.key_mode == offline::KeyMode::error);
@@ -77,7 +80,8 @@ Encoded encode_one(const std::string& in, const std::string& out, offline::Encod
   std::vector<double>().swap(motion.values);
   progress.compressing();
   // encode() made a clip the container can store: write_kanim cannot fail here.
-  const std::vector<uint8_t> bytes = offline::write_kanim(result.clip, settings.zstd_level);
+  const std::vector<uint8_t> bytes = runtime ? offline::write_kanim_runtime(offline::to_clip(result.clip))
+                                             : offline::write_kanim(result.clip, settings.zstd_level);
   const double encode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   Encoded e;
   e.summary = offline::encode_summary(in, out, motion, bvh_size, settings, result, bytes.size(), encode_ms);
@@ -136,7 +140,7 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
     std::error_code mk;
     std::filesystem::create_directories(dir, mk);
     if (mk) fail(kOutputFailed, dir.string() + ": cannot create: " + mk.message());
-    results[i] = encode_one(files[i], targets[i], settings, error_given, false, quiet);
+    results[i] = encode_one(files[i], targets[i], settings, error_given, false, args.has("--runtime"), quiet);
   }, files);
   nlohmann::json all = nlohmann::json::array();
   for (const Encoded& r : results) {
@@ -154,7 +158,7 @@ int encode_directory(const std::string& in, const std::string& out, const offlin
 }  // namespace
 
 int cmd_encode(const Argv& argv, Globals& g) {
-  std::set<std::string> valued{"-o", "--output", "-j", "--to"}, flags{"--json"};
+  std::set<std::string> valued{"-o", "--output", "-j", "--to"}, flags{"--json", "--runtime"};
   valued.insert(std::begin(kEncodeValuedOptions), std::end(kEncodeValuedOptions));
   valued.insert(std::begin(kManifestValuedOptions), std::end(kManifestValuedOptions));
   flags.insert(std::begin(kManifestFlags), std::end(kManifestFlags));
@@ -179,7 +183,7 @@ int cmd_encode(const Argv& argv, Globals& g) {
   if (json && out == "-") fail(kUsage, "--json and the .kanim would both go to standard output: give -o FILE");
   settings.threads = thread_count(args);  // one file: its channels in parallel
   Progress bar(g, in);
-  const Encoded e = encode_one(in, out, settings, args.has("--error"), to_kanim, g, &bar);
+  const Encoded e = encode_one(in, out, settings, args.has("--error"), to_kanim, args.has("--runtime"), g, &bar);
   bar.erase();
   if (json) std::cout << json_text(e.summary) << "\n";
   else if (g.verbosity > 0) std::cerr << human_line(e.summary) << "\n";

@@ -18,8 +18,9 @@ class Progress;
 
 // Checks the input and the output first (io.h), then encodes, writes atomically and returns
 // the summary printed by --json; fails (cli::Failure) otherwise. `to_given`: --to kanim, so
-// that `out` may have any name (formats.h). With `bar`, its stages show on it (progress.h).
+// that `out` may have any name (formats.h). `runtime`: --runtime, the runtime profile (spec
+// section 9) instead of the archive. With `bar`, its stages show on it (progress.h).
 Encoded encode_one(const std::string& in, const std::string& out, offline::EncodeSettings settings,
-                   bool error_given, bool to_given, const Globals& g, Progress* bar = nullptr);
+                   bool error_given, bool to_given, bool runtime, const Globals& g, Progress* bar = nullptr);
 
 }  // namespace keyanim::cli

@@ -213,7 +213,7 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
       if (skip_existing) mine.force = true;
       fs::create_directories(fs::path(out).parent_path(), ec);
       if (ec) fail(kOutputFailed, fs::path(out).parent_path().string() + ": cannot create: " + ec.message());
-      const nlohmann::json r = encode_one(in, out, one, args.has("--error"), false, mine).summary;
+      const nlohmann::json r = encode_one(in, out, one, args.has("--error"), false, args.has("--runtime"), mine).summary;
       tally.encoded(r);
       line.update({{"status", "ok"}, {"bytes", r["kanim_bytes"]}, {"max_error", r["error"]["max"]},
                    {"tolerance", r.value("tolerance", r.value("error_limit", 0.0))}, {"seconds", seconds_since(t0)}});

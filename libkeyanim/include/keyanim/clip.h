@@ -105,6 +105,13 @@ class Clip {
                           const DecodeLimits& limits = {}, RigCache* rigs = nullptr);
 
   uint16_t version_major() const noexcept;
+  // Whether the file was of the runtime profile (spec/FORMAT.md section 9), else the archive's.
+  bool runtime_profile() const noexcept;
+  // A runtime-profile clip's content rules (section 9.4: its image is exactly the one its keys
+  // make), which load() checks only with DecodeLimits::check_content and view() never: ok, or
+  // corrupt (with `err` saying so). Costs about an archive file's load. Always ok for a clip
+  // built from an archive file's keys. limit_exceeded when out of memory.
+  Status check_content(ErrorInfo* err = nullptr) const noexcept;
   uint16_t version_minor() const noexcept;
   uint32_t frame_count() const noexcept;
   double frame_time() const noexcept;

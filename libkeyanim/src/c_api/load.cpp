@@ -107,6 +107,32 @@ keyanim_status keyanim_clip_load_file(const char* path, keyanim_clip** out) {
   return keyanim_clip_load_file_limited(path, nullptr, out);
 }
 
+keyanim_status keyanim_clip_view(const uint8_t* bytes, size_t size, const keyanim_decode_limits* limits,
+                                 keyanim_rig_cache* rigs, keyanim_clip** out) {
+  const char* fn = "keyanim_clip_view";
+  if ((bytes == nullptr && size != 0) || (rigs != nullptr && was_freed_rigs(rigs))) {
+    if (out != nullptr) *out = nullptr;
+    return fail(Status::invalid_argument, fn, bytes == nullptr ? "bytes is NULL and size is %zu" : "rigs was freed", size);
+  }
+  static const uint64_t kNone = 0;  // a span of 0 bytes still needs an (aligned) address
+  const uint8_t* data = bytes != nullptr ? bytes : reinterpret_cast<const uint8_t*>(&kNone);
+  return load_into(fn, out, limits, [&](Clip& clip, ErrorInfo& info, const DecodeLimits& l) {
+    return Clip::view({data, size}, clip, &info, l, rigs != nullptr ? &rigs->rigs : nullptr);
+  });
+}
+
+int32_t keyanim_clip_runtime_profile(const keyanim_clip* h) {
+  const Clip* c = clip_of(h, "keyanim_clip_runtime_profile");
+  return c != nullptr && c->runtime_profile() ? 1 : 0;
+}
+
+keyanim_status keyanim_clip_check_content(const keyanim_clip* h) {
+  const Clip* c = clip_of(h, "keyanim_clip_check_content");
+  if (c == nullptr) return KEYANIM_INVALID_ARGUMENT;
+  ErrorInfo info;
+  return c->check_content(&info) == Status::ok ? KEYANIM_OK : fail_load(info);
+}
+
 void keyanim_clip_free(keyanim_clip* clip) {
   if (clip == nullptr) return;
   if (was_freed_clip(clip)) return (void)fail(Status::invalid_argument, "keyanim_clip_free", "clip was already freed");

@@ -56,6 +56,7 @@ Clip& Clip::operator=(Clip&&) noexcept = default;
 #define KEYANIM_IMG (image_ ? *image_ : empty_image())
 
 uint16_t Clip::version_major() const noexcept { return KEYANIM_IMG.version_major; }
+bool Clip::runtime_profile() const noexcept { return KEYANIM_IMG.runtime_profile; }
 uint16_t Clip::version_minor() const noexcept { return KEYANIM_IMG.version_minor; }
 uint32_t Clip::frame_count() const noexcept { return KEYANIM_IMG.frame_count; }
 double Clip::frame_time() const noexcept { return KEYANIM_IMG.frame_time; }

@@ -88,6 +88,7 @@ struct Image {
   std::shared_ptr<const void> storage;  // the bytes the spans below point into, unless viewed
   std::span<const uint8_t> imag;        // IMAG's content, 8-aligned
   size_t held_bytes = 0;                // bytes `storage` holds (the file's, or IMAG's)
+  bool runtime_profile = false;         // read from a runtime-profile file (spec section 9)
 
   // Per channel (frame column).
   std::span<const Interpolation> interp;

@@ -366,6 +366,7 @@ std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys,
   img->total_keys = total_keys;
   img->storage = std::move(storage);
   img->held_bytes = held_bytes;
+  img->runtime_profile = true;
   attach_image(*img, imag, channels);
   return img;
 }

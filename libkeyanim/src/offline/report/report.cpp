@@ -157,6 +157,7 @@ nlohmann::json kanim_info(const std::string& file, uint64_t bytes, const Clip& c
   nlohmann::json j = {{"file", file},
                       {"format", "kanim"},
                       {"version", std::to_string(clip.version_major()) + "." + std::to_string(clip.version_minor())},
+                      {"profile", clip.runtime_profile() ? "runtime" : "archive"},  // spec section 9
                       {"bytes", bytes},
                       {"checksum", "ok"}};
   j.update(skeleton_json(clip.skeleton()));

@@ -90,14 +90,13 @@ Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t>
   const std::span<const uint8_t> imag = loader.image();
   out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage),
                                               storage ? bytes.size() : 0, rigs));
-  if (limits.check_content && !internal::image_content_holds(ClipAccess::image(out))) {
+  if (!limits.check_content) return Status::ok;
+  const Status s = out.check_content(err);
+  if (s != Status::ok) {
+    if (err != nullptr) err->byte_offset = static_cast<uint64_t>(imag.data() - bytes.data());
     out = Clip{};
-    if (err != nullptr)
-      *err = ErrorInfo{Status::corrupt, static_cast<uint64_t>(imag.data() - bytes.data()), "IMAG",
-                       "the image is not the one its keys make (spec section 9.4, content rules)"};
-    return Status::corrupt;
   }
-  return Status::ok;
+  return s;
 }
 
 }  // namespace
@@ -126,6 +125,20 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
     return runtime_clip(again, std::move(facts), copy, std::move(words), limits, rigs, out, err);
   } catch (const std::bad_alloc&) {
     return out_of_memory(out, err);
+  }
+}
+
+Status Clip::check_content(ErrorInfo* err) const noexcept {
+  const internal::Image& img = ClipAccess::image(*this);
+  if (!img.runtime_profile) return Status::ok;
+  try {
+    if (internal::image_content_holds(img)) return Status::ok;
+    if (err != nullptr)
+      *err = ErrorInfo{Status::corrupt, 0, "IMAG", "the image is not the one its keys make (spec section 9.4, content rules)"};
+    return Status::corrupt;
+  } catch (const std::bad_alloc&) {
+    if (err != nullptr) *err = ErrorInfo{Status::limit_exceeded, 0, "IMAG", "out of memory"};
+    return Status::limit_exceeded;
   }
 }
 

@@ -83,7 +83,7 @@ Status Loader::read_header_and_table() {
       if (critical_tags[k] == e.tag) crit = k;
     if (runtime_ && (e.flags & internal::kSectionCompressed))
       return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": no section of the runtime profile is compressed");
-    if (runtime_ && crit == critical_count && !ancillary && e.tag != internal::kTagNote)
+    if (runtime_ && crit == critical_count && e.tag != internal::kTagNote)  // whatever its flags
       for (uint32_t tag : internal::kCriticalTags)
         if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
     if (crit < critical_count) {
