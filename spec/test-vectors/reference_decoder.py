@@ -109,11 +109,13 @@ class Reader:
         return self.pos == len(self.data)
 
 
-def parse(data):
-    """Returns a dict describing the clip; raises KanimError for a file that breaks the spec."""
+def parse(data, check_content=True):
+    """Returns a dict describing the clip; raises KanimError for a file that breaks the spec.
+    check_content=False skips the content rules of a runtime-profile file (9.4), as a player
+    that samples in place may: only for tests that tell the two classes of rules apart."""
     major, minor, runtime, count = parse_header(data)
     if runtime:
-        return parse_runtime(data, minor, count)
+        return parse_runtime(data, minor, count, check_content)
     return parse_archive(data, major, minor, count)
 
 
@@ -416,20 +418,21 @@ RUNTIME_SECTIONS = ["CLIP", "IMAG", "SKEL"]
 
 
 def runtime_sections(data, count):
-    """Rules 3.1 and 9.1 on the table: CLIP, IMAG, SKEL at entries 0-2, an optional NOTE at
-    entry 3, then only unknown ancillary sections; nothing compressed; the XXH64 at the end.
-    Returns {tag: content} of the known sections."""
+    """Rules 3.1 and 9.1 on the table: CLIP, IMAG, SKEL at entries 0-2, then at most one NOTE
+    (ancillary) and unknown ancillary sections, in any order; nothing compressed; the XXH64 at
+    the end. Returns {tag: content} of the known sections."""
     if len(data) < 24 + 24 * count + 8:
         raise KanimError("truncated", "table")
     entries = [struct.unpack_from("<4sIQQ", data, 24 + 24 * i) for i in range(count)]
-    for i, (tag, flags, stored, raw) in enumerate(entries):
-        tag, ancillary = tag.decode("latin-1"), bool(flags & 2)
+    tags = [e[0].decode("latin-1") for e in entries]
+    for i, (_, flags, stored, raw) in enumerate(entries):
+        tag, ancillary = tags[i], bool(flags & 2)
         if flags & 0xFFFC:
             raise KanimError("reserved_bits_set", f"table entry {i}: section flags")
         if i < 3 and (tag != RUNTIME_SECTIONS[i] or ancillary):
             raise KanimError("corrupt", f"table entry {i}: must be {RUNTIME_SECTIONS[i]}, critical (9.1)")
-        if i >= 3 and tag == "NOTE" and (i != 3 or not ancillary):
-            raise KanimError("corrupt", f"table entry {i}: NOTE must be entry 3, ancillary (9.1)")
+        if i >= 3 and tag == "NOTE" and (not ancillary or tag in tags[3:i]):
+            raise KanimError("corrupt", f"table entry {i}: NOTE must be ancillary, and appear once (9.1)")
         if i >= 3 and tag in RUNTIME_SECTIONS + CRITICAL:
             raise KanimError("corrupt", f"table entry {i}: {tag} in a runtime-profile file (9.1)")
         if i >= 3 and tag != "NOTE" and not ancillary:
@@ -448,20 +451,21 @@ def runtime_sections(data, count):
     if xxh64(data[:end]) != struct.unpack_from("<Q", data, end)[0]:
         raise KanimError("checksum_mismatch", "XXH64")
     content, pos = {}, 24 + 24 * count
-    for i, (tag, flags, stored, raw) in enumerate(entries):
-        if i < 4:  # CLIP, IMAG, SKEL, NOTE; the unknown ancillary sections are skipped
-            content.setdefault(tag.decode("latin-1"), data[pos:pos + stored])
+    for tag, (_, _, stored, _) in zip(tags, entries):
+        if tag in RUNTIME_SECTIONS + ["NOTE"]:  # the unknown ancillary sections are skipped
+            content[tag] = data[pos:pos + stored]
         pos += stored
     return content
 
 
-def parse_runtime(data, minor, count):
+def parse_runtime(data, minor, count, check_content=True):
     """A runtime-profile file (section 9): its keys recovered from IMAG, structure and content
     checked (9.4), in the same dict as parse_archive's."""
     content = runtime_sections(data, count)
     F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
     image = parse_image(content["IMAG"], F, C, K)
-    check_image_content(image)
+    if check_content:
+        check_image_content(image)
     nodes = parse_skel(content["SKEL"], N, C)
     return {"version": (4, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": image["interp"], "tension": image["tension"],
@@ -657,6 +661,8 @@ def read_record(payload, pos, P, wc, b, F, where):
     if pos + 10 > P:
         raise KanimError("corrupt", f"IMAG: {where} runs past Payload_Size")
     mask = struct.unpack_from("<Q", payload, pos)[0]
+    if F - 64 * b < 64 and mask >> (F - 64 * b):
+        raise KanimError("corrupt", f"IMAG: {where}: Mask bit of a frame >= Frame_Count")
     w, wk = payload[pos + 8], payload[pos + 9]
     if w > 55:
         raise KanimError("corrupt", f"IMAG: {where}: Value_Bits {w} > 55")
@@ -670,8 +676,6 @@ def read_record(payload, pos, P, wc, b, F, where):
     bits = int.from_bytes(payload[pos:pos + size], "little")
     if bits >> nbits:
         raise KanimError("corrupt", f"IMAG: {where}: bits after its last field")
-    if F - 64 * b < 64 and mask >> (F - 64 * b):
-        raise KanimError("corrupt", f"IMAG: {where}: Mask bit of a frame >= Frame_Count")
     fields, p = [], 80
     for width in [wk] * 4 + [wc] + [w] * (m + 4):
         fields.append((bits >> p) & ((1 << width) - 1))
