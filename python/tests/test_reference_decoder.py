@@ -471,6 +471,22 @@ def test_what_9_1_allows_is_accepted():
         assert like == "v3_rules" or clip["notes"].startswith("encoder=")
 
 
+@pytest.mark.parametrize("bvh", ["cmu_02_01_walk.bvh", "cmu_131_03_hop.bvh"])
+def test_keyanim_runtime_files_of_real_clips_pass_every_check(bvh, tmp_path):
+    """The shipped clips, encoded and converted by the tool: the runtime file passes the content
+    checks too and holds the archive file's keys, value bits included (hop has records with a
+    Value_Bits of 0, which no vector has)."""
+    tool = os.environ.get("KEYANIM_CLI")
+    if not tool or not os.path.exists(tool):
+        pytest.skip("the keyanim tool is not built (KEYANIM_CLI)")
+    archive, runtime = tmp_path / "a.kanim", tmp_path / "r.kanim"
+    subprocess.run([tool, "-q", "encode", str(REPO / "data" / bvh), "-o", str(archive), "--error", "0.5%"], check=True)
+    subprocess.run([tool, "-q", "convert", str(archive), "--runtime", "-o", str(runtime)], check=True)
+    a, r = rd.parse(archive.read_bytes()), rd.parse(runtime.read_bytes())
+    assert r["version"] == (4, 0) and a["frames"] == r["frames"]
+    assert [[rd.f32_bits(v) for v in c] for c in a["values"]] == [[rd.f32_bits(v) for v in c] for c in r["values"]]
+
+
 def test_runtime_clear_reads_a_runtime_layout_as_an_archive_file_and_refuses_it():
     data = header_flags("v4_rules.kanim", 0)
     with pytest.raises(rd.KanimError):
