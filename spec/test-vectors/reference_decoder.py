@@ -1,16 +1,23 @@
 #!/usr/bin/env python3
-"""Reference decoder for .kanim 3.0 (and 2.0, 1.0: Appendix E), written from spec/FORMAT.md alone.
+"""Reference decoder for .kanim 4.0 (both profiles) and 3.0, 2.0, 1.0 (Appendix E), written from
+spec/FORMAT.md alone.
 
 It shares no code with the C++ library: it parses the bytes, checks the rules of the spec,
 and evaluates Appendix A in binary32 (every operation computed in binary64 and rounded once to
 binary32, which gives the correctly rounded binary32 result for + - * /, since 53 >= 2*24 + 2).
+A runtime-profile file (section 9) has its keys recovered from IMAG (9.3) after every structure
+rule of 9.4, and then its content checked too: the image is rebuilt from the recovered keys and
+compared field by field (9.4 lets a decoder skip this; an independent check should not). Its
+keys are then evaluated by the same Appendix A code as an archive file's.
 
 Usage:
   reference_decoder.py FILE.kanim [POSITION ...]   print the values at these frame positions
   reference_decoder.py --write-json DIR            write DIR/NAME.json for every DIR/*.kanim
 
 Needs only the Python standard library, plus either the `zstandard` module or the `zstd`
-command-line program for compressed sections.
+command-line program for compressed sections (archive profile). The runtime profile's XXH64
+uses the `xxhash` module (Debian: python3-xxhash) when it is installed, else xxh64_pure below,
+written from xxHash's specification (same results, slower).
 """
 import glob
 import json
@@ -33,8 +40,17 @@ class KanimError(Exception):
 
 
 def f32(x):
-    """Round a Python float (binary64) to the nearest binary32, as a Python float."""
-    return struct.unpack("<f", struct.pack("<f", x))[0]
+    """Round a Python float (binary64) to the nearest binary32, as a Python float (an overflow
+    gives the infinity of its sign, as the rounding of IEEE 754 does)."""
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:  # struct refuses what rounds beyond the largest binary32
+        return math.copysign(math.inf, x)
+
+
+def f32_bits(x):
+    """The binary32 encoding of x (a binary32 value held in a Python float): tells -0 from +0."""
+    return struct.unpack("<I", struct.pack("<f", x))[0]
 
 
 def zstd_decompress(data):
@@ -93,17 +109,77 @@ class Reader:
         return self.pos == len(self.data)
 
 
-def parse(data):
-    """Returns a dict describing the clip; raises KanimError for a file that breaks the spec."""
+def parse(data, check_content=True):
+    """Returns a dict describing the clip; raises KanimError for a file that breaks the spec.
+    check_content=False skips the content rules of a runtime-profile file (9.4), as a player
+    that samples in place may: only for tests that tell the two classes of rules apart."""
+    major, minor, runtime, count = parse_header(data)
+    if runtime:
+        return parse_runtime(data, minor, count, check_content)
+    return parse_archive(data, major, minor, count)
+
+
+def parse_header(data):
+    """Signature and header (2.1, 2.2): (major, minor, Runtime flag, Section_Count)."""
     if data[:min(8, len(data))] != SIGNATURE[:min(8, len(data))]:
         raise KanimError("bad_signature", "signature")
     if len(data) < 24:
         raise KanimError("truncated", "header")
     major, minor, header_flags, count, reserved = struct.unpack_from("<HHIII", data, 8)
-    if major not in (1, 2, 3):
+    if major not in (1, 2, 3, 4):
         raise KanimError("unsupported_version", f"major {major}")
-    if header_flags & 0xFFFF or reserved:
+    # Bit 0 is Runtime in version 4 (section 9) and reserved before; bits 1-15 are reserved.
+    if header_flags & (0xFFFE if major == 4 else 0xFFFF) or reserved:
         raise KanimError("reserved_bits_set", "header")
+    return major, minor, bool(header_flags & 1), count
+
+
+def parse_clip(clip):
+    """CLIP (4.1): (F, N, C, Tangent_Rule, Frame_Time, K)."""
+    if len(clip) != 32:
+        raise KanimError("corrupt", "CLIP size")
+    F, N, C, rule, clip_flags, clip_reserved, frame_time, K = struct.unpack("<IIIBBHdQ", clip)
+    if rule > 1 or clip_flags or clip_reserved:
+        raise KanimError("reserved_bits_set", "CLIP")
+    if not math.isfinite(frame_time) or frame_time < 0 or (F > 1 and not frame_time > 0):
+        raise KanimError("corrupt", "Frame_Time")
+    if K > C * F:
+        raise KanimError("corrupt", "Key_Count")
+    return F, N, C, rule, frame_time, K
+
+
+def parse_skel(skel, N, C):
+    """SKEL (4.2): the nodes, checked against N and C."""
+    r = Reader(skel, "SKEL")
+    nodes = []
+    channel_total = 0
+    for i in range(N):
+        (name_len,) = r.unpack("I")
+        name = r.take(name_len).decode("utf-8", errors="surrogateescape")
+        (parent,) = r.unpack("i")
+        offset = list(r.unpack("3d"))
+        node_flags, n_ch = r.unpack("BB")
+        types = list(r.take(n_ch))
+        end_site = bool(node_flags & 1)
+        if node_flags & 0xFE or any(t > 5 for t in types):
+            raise KanimError("reserved_bits_set", f"node {i}")
+        if not (parent == -1 or 0 <= parent < i) or (parent >= 0 and nodes[parent]["end_site"]):
+            raise KanimError("corrupt", f"node {i} parent")
+        if not all(math.isfinite(o) for o in offset) or n_ch > 6:
+            raise KanimError("corrupt", f"node {i}")
+        if end_site and (n_ch != 0 or parent < 0):
+            raise KanimError("corrupt", f"node {i} End Site")
+        nodes.append({"name": name, "parent": parent, "end_site": end_site, "offset": offset,
+                      "channels": [CHANNEL_NAMES[t] for t in types]})
+        channel_total += n_ch
+    if not r.at_end() or channel_total != C:
+        raise KanimError("corrupt", "SKEL")
+    return nodes
+
+
+def parse_archive(data, major, minor, count):
+    """The archive profile: versions 1 to 3, and 4 with Runtime clear (laid out as 3.0)."""
+    layout = min(major, 3)  # 4.0's archive profile has 3.0's bytes (section 9)
     if len(data) < 24 + 24 * count + 4:
         raise KanimError("truncated", "table")
     sections = []
@@ -152,52 +228,17 @@ def parse(data):
     if critical_seen != CRITICAL:
         raise KanimError("corrupt", f"critical sections {critical_seen}")
 
-    # CLIP
-    clip = content["CLIP"]
-    if len(clip) != 32:
-        raise KanimError("corrupt", "CLIP size")
-    F, N, C, rule, clip_flags, clip_reserved, frame_time, K = struct.unpack("<IIIBBHdQ", clip)
-    if rule > 1 or clip_flags or clip_reserved:
-        raise KanimError("reserved_bits_set", "CLIP")
-    if not math.isfinite(frame_time) or frame_time < 0 or (F > 1 and not frame_time > 0):
-        raise KanimError("corrupt", "Frame_Time")
-    if K > C * F:
-        raise KanimError("corrupt", "Key_Count")
-
-    # SKEL
-    r = Reader(content["SKEL"], "SKEL")
-    nodes = []
-    channel_total = 0
-    for i in range(N):
-        (name_len,) = r.unpack("I")
-        name = r.take(name_len).decode("utf-8", errors="surrogateescape")
-        (parent,) = r.unpack("i")
-        offset = list(r.unpack("3d"))
-        node_flags, n_ch = r.unpack("BB")
-        types = list(r.take(n_ch))
-        end_site = bool(node_flags & 1)
-        if node_flags & 0xFE or any(t > 5 for t in types):
-            raise KanimError("reserved_bits_set", f"node {i}")
-        if not (parent == -1 or 0 <= parent < i) or (parent >= 0 and nodes[parent]["end_site"]):
-            raise KanimError("corrupt", f"node {i} parent")
-        if not all(math.isfinite(o) for o in offset) or n_ch > 6:
-            raise KanimError("corrupt", f"node {i}")
-        if end_site and (n_ch != 0 or parent < 0):
-            raise KanimError("corrupt", f"node {i} End Site")
-        nodes.append({"name": name, "parent": parent, "end_site": end_site, "offset": offset,
-                      "channels": [CHANNEL_NAMES[t] for t in types]})
-        channel_total += n_ch
-    if not r.at_end() or channel_total != C:
-        raise KanimError("corrupt", "SKEL")
+    F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
+    nodes = parse_skel(content["SKEL"], N, C)
 
     # CHAN
     chan = content["CHAN"]
-    if len(chan) != {1: 17, 2: 18, 3: 19}[major] * C:
+    if len(chan) != {1: 17, 2: 18, 3: 19}[layout] * C:
         raise KanimError("corrupt", "CHAN size")
     # Value_Coding (2.0 on): 0 delta, 1 extrapolate; version 1 has only deltas.
-    coding = list(chan[17 * C:18 * C]) if major >= 2 else [0] * C
+    coding = list(chan[17 * C:18 * C]) if layout >= 2 else [0] * C
     # Residual_Bytes (3.0): bytes of each zigzag residual in KVAL.
-    residual_bytes = list(chan[18 * C:19 * C]) if major == 3 else None
+    residual_bytes = list(chan[18 * C:19 * C]) if layout == 3 else None
     interp = list(chan[:C])
     tension = list(struct.unpack_from(f"<{C}f", chan, C))
     step = list(struct.unpack_from(f"<{C}d", chan, 5 * C))
@@ -233,7 +274,7 @@ def parse(data):
         raise KanimError("corrupt", "KTIM size")
 
     kval = content["KVAL"]
-    if major == 3:
+    if layout == 3:
         # KVAL (3.0): plane k holds byte k (little-endian) of every zigzag residual of the
         # channels whose Residual_Bytes exceed k, channel after channel, key after key.
         sizes = [sum(key_count[c] for c in range(C) if residual_bytes[c] > k) for k in range(8)]
@@ -296,7 +337,7 @@ def parse(data):
         for i in range(key_count[c]):
             u = next_residual(c)
             r = (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
-            if abs(r) > (2 ** 57 if major >= 2 else 2 ** 54):
+            if abs(r) > (2 ** 57 if layout >= 2 else 2 ** 54):
                 raise KanimError("corrupt", f"channel {c} residual")
             q = prediction(c, qs, i) + r
             qs.append(q)
@@ -307,12 +348,448 @@ def parse(data):
                 raise KanimError("corrupt", f"channel {c} value")
             vals.append(v)
         values.append(vals)
-    if major < 3 and not all(p.at_end() for p in planes):
+    if layout < 3 and not all(p.at_end() for p in planes):
         raise KanimError("corrupt", "KVAL plane bytes left over")
 
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": interp, "tension": tension, "frames": frames, "values": values,
             "notes": content.get("NOTE", b"").decode("utf-8", errors="surrogateescape")}
+
+
+# ---------------------------------------------------------------------------------------------
+# The runtime profile (section 9): CLIP, IMAG, SKEL, NOTE uncompressed, XXH64 at the end.
+
+XXH_P1, XXH_P2, XXH_P3 = 0x9E3779B185EBCA87, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9
+XXH_P4, XXH_P5 = 0x85EBCA77C2B2AE63, 0x27D4EB2F165667C5
+U64 = (1 << 64) - 1
+
+
+def _rotl64(x, r):
+    return ((x << r) | (x >> (64 - r))) & U64
+
+
+def _xxh64_round(acc, lane):
+    return (_rotl64((acc + lane * XXH_P2) & U64, 31) * XXH_P1) & U64
+
+
+def xxh64_pure(data, seed=0):
+    """XXH64 written from xxHash's doc/xxhash_spec.md (stripes of 4 lanes, merge, tail,
+    avalanche), in Python's integers masked to 64 bits."""
+    n, p = len(data), 0
+    if n >= 32:
+        v = [(seed + XXH_P1 + XXH_P2) & U64, (seed + XXH_P2) & U64, seed & U64, (seed - XXH_P1) & U64]
+        while p + 32 <= n:
+            lanes = struct.unpack_from("<4Q", data, p)
+            v = [_xxh64_round(v[i], lanes[i]) for i in range(4)]
+            p += 32
+        acc = (_rotl64(v[0], 1) + _rotl64(v[1], 7) + _rotl64(v[2], 12) + _rotl64(v[3], 18)) & U64
+        for lane in v:
+            acc = ((acc ^ _xxh64_round(0, lane)) * XXH_P1 + XXH_P4) & U64
+    else:
+        acc = (seed + XXH_P5) & U64
+    acc = (acc + n) & U64
+    while p + 8 <= n:
+        acc ^= _xxh64_round(0, struct.unpack_from("<Q", data, p)[0])
+        acc = (_rotl64(acc, 27) * XXH_P1 + XXH_P4) & U64
+        p += 8
+    if p + 4 <= n:
+        acc ^= (struct.unpack_from("<I", data, p)[0] * XXH_P1) & U64
+        acc = (_rotl64(acc, 23) * XXH_P2 + XXH_P3) & U64
+        p += 4
+    while p < n:
+        acc ^= (data[p] * XXH_P5) & U64
+        acc = (_rotl64(acc, 11) * XXH_P1) & U64
+        p += 1
+    acc = ((acc ^ (acc >> 33)) * XXH_P2) & U64
+    acc = ((acc ^ (acc >> 29)) * XXH_P3) & U64
+    return acc ^ (acc >> 32)
+
+
+def xxh64(data):
+    """XXH64, seed 0: the `xxhash` module when it is installed (faster), else xxh64_pure."""
+    try:
+        import xxhash  # type: ignore
+    except ImportError:
+        return xxh64_pure(data)
+    return xxhash.xxh64(data).intdigest()
+
+
+RUNTIME_SECTIONS = ["CLIP", "IMAG", "SKEL"]
+
+
+def runtime_sections(data, count):
+    """Rules 3.1 and 9.1 on the table: CLIP, IMAG, SKEL at entries 0-2, then at most one NOTE
+    (ancillary) and unknown ancillary sections, in any order; nothing compressed; the XXH64 at
+    the end. Returns {tag: content} of the known sections."""
+    if len(data) < 24 + 24 * count + 8:
+        raise KanimError("truncated", "table")
+    entries = [struct.unpack_from("<4sIQQ", data, 24 + 24 * i) for i in range(count)]
+    tags = [e[0].decode("latin-1") for e in entries]
+    for i, (_, flags, stored, raw) in enumerate(entries):
+        tag, ancillary = tags[i], bool(flags & 2)
+        if flags & 0xFFFC:
+            raise KanimError("reserved_bits_set", f"table entry {i}: section flags")
+        if i < 3 and (tag != RUNTIME_SECTIONS[i] or ancillary):
+            raise KanimError("corrupt", f"table entry {i}: must be {RUNTIME_SECTIONS[i]}, critical (9.1)")
+        if i >= 3 and tag == "NOTE" and (not ancillary or tag in tags[3:i]):
+            raise KanimError("corrupt", f"table entry {i}: NOTE must be ancillary, and appear once (9.1)")
+        if i >= 3 and tag in RUNTIME_SECTIONS + CRITICAL:
+            raise KanimError("corrupt", f"table entry {i}: {tag} in a runtime-profile file (9.1)")
+        if i >= 3 and tag != "NOTE" and not ancillary:
+            raise KanimError("reserved_bits_set", f"table entry {i}: unknown critical section {tag}")
+        if flags & 1:
+            raise KanimError("corrupt", f"table entry {i}: {tag} compressed (9.1)")
+        if raw != stored:
+            raise KanimError("corrupt", f"table entry {i}: {tag} Raw_Size != Stored_Size")
+    if count < 3:
+        raise KanimError("corrupt", "table: fewer than CLIP, IMAG, SKEL (9.1)")
+    end = 24 + 24 * count + sum(e[2] for e in entries)
+    if len(data) < end + 8:
+        raise KanimError("truncated", "sections")
+    if len(data) > end + 8:
+        raise KanimError("trailing_bytes", "after checksum")
+    if xxh64(data[:end]) != struct.unpack_from("<Q", data, end)[0]:
+        raise KanimError("checksum_mismatch", "XXH64")
+    content, pos = {}, 24 + 24 * count
+    for tag, (_, _, stored, _) in zip(tags, entries):
+        if tag in RUNTIME_SECTIONS + ["NOTE"]:  # the unknown ancillary sections are skipped
+            content[tag] = data[pos:pos + stored]
+        pos += stored
+    return content
+
+
+def parse_runtime(data, minor, count, check_content=True):
+    """A runtime-profile file (section 9): its keys recovered from IMAG, structure and content
+    checked (9.4), in the same dict as parse_archive's."""
+    content = runtime_sections(data, count)
+    F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
+    image = parse_image(content["IMAG"], F, C, K)
+    if check_content:
+        check_image_content(image)
+    nodes = parse_skel(content["SKEL"], N, C)
+    return {"version": (4, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
+            "nodes": nodes, "interp": image["interp"], "tension": image["tension"],
+            "frames": image["frames"], "values": image["values"],
+            "notes": content.get("NOTE", b"").decode("utf-8", errors="surrogateescape")}
+
+
+# ---- IMAG (9.2): header and arrays.
+
+def pad8(n):
+    return (n + 7) // 8 * 8
+
+
+def image_header(body, F, C):
+    """IMAG's 32-byte header: the counts that size its arrays (9.2)."""
+    if len(body) < 32:
+        raise KanimError("corrupt", "IMAG: header")
+    shift, nc, nb, B, M, P, reserved0, reserved1 = struct.unpack_from("<8I", body, 0)
+    if shift != 6:
+        raise KanimError("corrupt", "IMAG: Block_Shift")
+    if nc > C:
+        raise KanimError("corrupt", "IMAG: Curve_Count")
+    if nb > nc:
+        raise KanimError("corrupt", "IMAG: Block_Curve_Count")
+    if B != ((F + 63) // 64 if nc else 0):
+        raise KanimError("corrupt", "IMAG: Block_Count")
+    if reserved0 or reserved1:
+        raise KanimError("reserved_bits_set", "IMAG: Image_Reserved")
+    return {"nc": nc, "nb": nb, "nl": nc - nb, "B": B, "M": M, "P": P, "L": 4 * ((nc + 3) // 4),
+            "X": C - nc, "R": B * nb, "F": F, "C": C}
+
+
+def image_array_specs(h):
+    """(name, struct format of one entry, entries) of IMAG's arrays, in file order (9.2)."""
+    C, L, nc, M = h["C"], h["L"], h["nc"], h["M"]
+    return [("Interpolation", "B", C), ("Tension", "f", C), ("Key_Count", "I", C),
+            ("Curve_Of", "I", C), ("Fixed_Value", "f", C), ("Fixed_Frame", "I", C),
+            ("Fixed_Channels", "I", h["X"]), ("Curves", "qdII", nc), ("Curve_S", "f", L),
+            ("First_Frame", "f", L), ("Last_Frame", "f", L), ("First_Value", "f", L),
+            ("Last_Value", "f", L), ("Curve_Linear", "I", L), ("Curve_Channel", "I", nc),
+            ("Lists", "II", h["nl"]), ("List_Frames", "I", M), ("List_Values", "f", M),
+            ("List_Q", "q", M), ("Record_Offset", "I", h["R"] + 8), ("Payload", None, h["P"] + 8)]
+
+
+def image_arrays(body, h):
+    """Every array of IMAG, after checking Raw_Size and every Pad byte. Float arrays are read
+    twice: as values, and as their bits under NAME_bits (to compare -0 and +0 exactly)."""
+    specs = image_array_specs(h)
+    sizes = [struct.calcsize("<" + fmt) * n if fmt else n for _, fmt, n in specs]
+    if len(body) != 32 + sum(pad8(s) for s in sizes):
+        raise KanimError("corrupt", "IMAG: Raw_Size against the arrays' sizes")
+    a, pos = {}, 32
+    for (name, fmt, n), size in zip(specs, sizes):
+        if any(body[pos + size:pos + pad8(size)]):
+            raise KanimError("corrupt", f"IMAG: {name}'s Pad")
+        raw = body[pos:pos + size]
+        if fmt is None:
+            a[name] = raw
+        else:
+            flat = struct.unpack("<" + fmt * n, raw) if n else ()
+            a[name] = [flat[i:i + len(fmt)] for i in range(0, len(flat), len(fmt))] if len(fmt) > 1 else list(flat)
+            if fmt == "f":
+                a[name + "_bits"] = list(struct.unpack(f"<{n}I", raw))
+        pos += pad8(size)
+    return a
+
+
+# ---- IMAG (9.2): the rules of its tables.
+
+def check_channel_arrays(a, h, K):
+    """The per-channel arrays, and which channels are block curves, list curves, fixed (9.2)."""
+    F, C, n = h["F"], h["C"], a["Key_Count"]
+    for c in range(C):
+        if a["Interpolation"][c] > 1:
+            raise KanimError("reserved_bits_set", f"IMAG: Interpolation[{c}]")
+    for c in range(C):
+        t = a["Tension"][c]
+        if not (math.isfinite(t) and -1 <= t <= 1):
+            raise KanimError("corrupt", f"IMAG: Tension[{c}]")
+    for c in range(C):
+        if n[c] > F:
+            raise KanimError("corrupt", f"IMAG: Key_Count[{c}] > Frame_Count")
+    if sum(n) != K:
+        raise KanimError("corrupt", "IMAG: Key_Count sum != CLIP's Key_Count")
+    # A list curve has fewer keys than a quarter of the blocks (9.2); block curves come first.
+    curves = [c for c in range(C) if n[c] >= 2]
+    lists = [c for c in curves if 4 * n[c] < (F + 63) // 64]
+    order = [c for c in curves if c not in lists] + lists
+    if len(curves) != h["nc"] or len(order) - len(lists) != h["nb"]:
+        raise KanimError("corrupt", "IMAG: Curve_Count or Block_Curve_Count against Key_Count")
+    curve_of = [0xFFFFFFFF] * C
+    for i, c in enumerate(order):
+        curve_of[c] = i
+    for c in range(C):
+        if a["Curve_Of"][c] != curve_of[c]:
+            raise KanimError("corrupt", f"IMAG: Curve_Of[{c}]")
+    for c in range(C):
+        one = n[c] == 1
+        if one and not math.isfinite(a["Fixed_Value"][c]) or not one and a["Fixed_Value_bits"][c] != 0:
+            raise KanimError("corrupt", f"IMAG: Fixed_Value[{c}]")
+        if one and a["Fixed_Frame"][c] >= F or not one and a["Fixed_Frame"][c] != 0:
+            raise KanimError("corrupt", f"IMAG: Fixed_Frame[{c}]")
+    if a["Fixed_Channels"] != [c for c in range(C) if n[c] <= 1]:
+        raise KanimError("corrupt", "IMAG: Fixed_Channels")
+    if a["Curve_Channel"] != order:
+        raise KanimError("corrupt", "IMAG: Curve_Channel")
+
+
+INF32_BITS = 0x7F800000
+
+
+def check_curve_arrays(a, h):
+    """Curves and the per-curve lanes (9.2), apart from what the keys fix (First_*, Last_*)."""
+    nc = h["nc"]
+    for i in range(nc):
+        q_base, step, base_bits, reserved = a["Curves"][i]
+        if abs(q_base) > 2 ** 53:
+            raise KanimError("corrupt", f"IMAG: Curves[{i}].Q_Base")
+        if not (math.isfinite(step) and step > 0):
+            raise KanimError("corrupt", f"IMAG: Curves[{i}].Step")
+        if base_bits > 55:
+            raise KanimError("corrupt", f"IMAG: Curves[{i}].Base_Bits")
+        if reserved:
+            raise KanimError("reserved_bits_set", f"IMAG: Curves[{i}].Curve_Reserved")
+    for i in range(h["L"]):
+        c = a["Curve_Channel"][i] if i < nc else None
+        s = f32(f32(1.0 - a["Tension"][c]) * 0.5) if i < nc else 0.0
+        if a["Curve_S_bits"][i] != f32_bits(s):
+            raise KanimError("corrupt", f"IMAG: Curve_S[{i}]")
+        if i >= nc and (a["First_Frame_bits"][i] != INF32_BITS or a["Last_Frame_bits"][i] != INF32_BITS or
+                        a["First_Value_bits"][i] or a["Last_Value_bits"][i]):
+            raise KanimError("corrupt", f"IMAG: padding lane {i} of First/Last_Frame/Value")
+        linear = 0xFFFFFFFF if i < nc and a["Interpolation"][c] == 1 else 0
+        if a["Curve_Linear"][i] != linear:
+            raise KanimError("corrupt", f"IMAG: Curve_Linear[{i}]")
+
+
+def check_curve_ends(a, i, frames, values, with_values):
+    """First_Frame, Last_Frame (and First_Value, Last_Value) of curve i against its keys."""
+    if a["First_Frame_bits"][i] != f32_bits(f32(float(frames[0]))):
+        raise KanimError("corrupt", f"IMAG: First_Frame[{i}]")
+    if a["Last_Frame_bits"][i] != f32_bits(f32(float(frames[-1]))):
+        raise KanimError("corrupt", f"IMAG: Last_Frame[{i}]")
+    if with_values and a["First_Value_bits"][i] != f32_bits(values[0]):
+        raise KanimError("corrupt", f"IMAG: First_Value[{i}]")
+    if with_values and a["Last_Value_bits"][i] != f32_bits(values[-1]):
+        raise KanimError("corrupt", f"IMAG: Last_Value[{i}]")
+
+
+def list_curve_keys(a, h):
+    """The list curves' keys (9.2 Lists, List_*), checked key by key: {curve: (frames, q, v)}."""
+    keys, first = {}, 0
+    for j in range(h["nl"]):
+        i = h["nb"] + j
+        start, count = a["Lists"][j]
+        if start != first or count != a["Key_Count"][a["Curve_Channel"][i]]:
+            raise KanimError("corrupt", f"IMAG: Lists[{j}]")
+        first += count
+    if first != h["M"]:
+        raise KanimError("corrupt", "IMAG: List_Key_Count against the lists' Count")
+    for j in range(h["nl"]):
+        i = h["nb"] + j
+        start, count = a["Lists"][j]
+        step = a["Curves"][i][1]
+        frames, qs = a["List_Frames"][start:start + count], a["List_Q"][start:start + count]
+        for x in range(count):
+            if frames[x] >= h["F"] or (x and frames[x] <= frames[x - 1]):
+                raise KanimError("corrupt", f"IMAG: List_Frames[{start + x}]")
+            if abs(qs[x]) > 2 ** 53:
+                raise KanimError("corrupt", f"IMAG: List_Q[{start + x}]")
+            v = f32(float(qs[x]) * step)
+            if not math.isfinite(v) or a["List_Values_bits"][start + x] != f32_bits(v):
+                raise KanimError("corrupt", f"IMAG: List_Values[{start + x}]")
+        values = a["List_Values"][start:start + count]
+        check_curve_ends(a, i, frames, values, with_values=True)
+        keys[i] = (frames, qs, values)
+    return keys
+
+
+# ---- IMAG (9.3): the records.
+
+def unzigzag(u):
+    return (u >> 1) if u % 2 == 0 else -((u + 1) >> 1)
+
+
+def zigzag(d):
+    return 2 * d if d >= 0 else -2 * d - 1
+
+
+def read_record(payload, pos, P, wc, b, F, where):
+    """Block b's record at byte pos of Payload: its fields, after the structure rules of 9.3
+    and 9.4 (widths, size within Payload_Size, zero bits after it, Mask, window order)."""
+    if pos + 10 > P:
+        raise KanimError("corrupt", f"IMAG: {where} runs past Payload_Size")
+    mask = struct.unpack_from("<Q", payload, pos)[0]
+    if F - 64 * b < 64 and mask >> (F - 64 * b):
+        raise KanimError("corrupt", f"IMAG: {where}: Mask bit of a frame >= Frame_Count")
+    w, wk = payload[pos + 8], payload[pos + 9]
+    if w > 55:
+        raise KanimError("corrupt", f"IMAG: {where}: Value_Bits {w} > 55")
+    if wk > 31:
+        raise KanimError("corrupt", f"IMAG: {where}: Context_Bits {wk} > 31")
+    m = bin(mask).count("1")
+    nbits = 80 + 4 * wk + wc + (m + 4) * w
+    size = (nbits + 7) // 8
+    if pos + size > P:
+        raise KanimError("corrupt", f"IMAG: {where} runs past Payload_Size")
+    bits = int.from_bytes(payload[pos:pos + size], "little")
+    if bits >> nbits:
+        raise KanimError("corrupt", f"IMAG: {where}: bits after its last field")
+    fields, p = [], 80
+    for width in [wk] * 4 + [wc] + [w] * (m + 4):
+        fields.append((bits >> p) & ((1 << width) - 1))
+        p += width
+    ctx, base, values = fields[:4], fields[4], fields[5:]
+    lo, hi = 64 * b, 64 * b + 64
+    e = [lo + unzigzag(ctx[0]), lo + unzigzag(ctx[1]), hi + unzigzag(ctx[2]), hi + unzigzag(ctx[3])]
+    frames = [lo + t for t in range(64) if mask >> t & 1]
+    order = e[:2] + frames + e[2:]  # e_0 < e_1 < the block's keys < e_2 < e_3
+    if not all(x < y for x, y in zip(order, order[1:])):
+        raise KanimError("corrupt", f"IMAG: {where}: window frames out of order")
+    return {"size": size, "Value_Bits": w, "Context_Bits": wk, "Context": ctx, "Base": base,
+            "Values": values, "frames": frames}
+
+
+def block_curve_keys(a, h):
+    """Every record, block-major, checked against Record_Offset; the block curves' keys
+    (9.3 "The keys of a curve"): {curve: (frames, q, v)}, and the records {curve: [record]}."""
+    payload, offsets, nb, P = a["Payload"], a["Record_Offset"], h["nb"], h["P"]
+    records = {i: [] for i in range(nb)}
+    pos = 0
+    for b in range(h["B"]):
+        for i in range(nb):
+            if offsets[b * nb + i] != pos:
+                raise KanimError("corrupt", f"IMAG: Record_Offset[{b * nb + i}]")
+            where = f"record of block {b}, curve {i}"
+            records[i].append(read_record(payload, pos, P, a["Curves"][i][2], b, h["F"], where))
+            pos += records[i][-1]["size"]
+    if pos != P:
+        raise KanimError("corrupt", "IMAG: the records end before Payload_Size")
+    if any(offsets[h["R"]:]) or any(payload[P:]):
+        raise KanimError("corrupt", "IMAG: the 8 entries after the records' offsets, or bytes after the records, not 0")
+    keys = {}
+    for i in range(nb):
+        q_base, step = a["Curves"][i][0], a["Curves"][i][1]
+        frames, qs = [], []
+        for rec in records[i]:
+            frames += rec["frames"]
+            qs += [q_base + rec["Base"] + x for x in rec["Values"][2:2 + len(rec["frames"])]]
+        if len(frames) != a["Key_Count"][a["Curve_Channel"][i]]:
+            raise KanimError("corrupt", f"IMAG: curve {i}: the records' popcounts against its Key_Count")
+        check_curve_ends(a, i, frames, None, with_values=False)
+        keys[i] = (frames, qs, [f32(float(q) * step) for q in qs])
+    return keys, records
+
+
+def parse_image(body, F, C, K):
+    """IMAG: every structure rule of 9.4, then each channel's keys (9.3)."""
+    h = image_header(body, F, C)
+    a = image_arrays(body, h)
+    check_channel_arrays(a, h, K)
+    check_curve_arrays(a, h)
+    keys = list_curve_keys(a, h)
+    block_keys, records = block_curve_keys(a, h)
+    keys.update(block_keys)
+    frames, values = [], []
+    for c in range(C):
+        if a["Key_Count"][c] >= 2:
+            k = keys[a["Curve_Of"][c]]
+            frames.append(list(k[0]))
+            values.append(list(k[2]))
+        else:  # a fixed channel: no key (0 everywhere) or one
+            frames.append([a["Fixed_Frame"][c]] if a["Key_Count"][c] else [])
+            values.append([a["Fixed_Value"][c]] if a["Key_Count"][c] else [])
+    return {"header": h, "arrays": a, "keys": keys, "records": records, "interp": a["Interpolation"],
+            "tension": a["Tension"], "frames": frames, "values": values}
+
+
+# ---- IMAG (9.4): the content rules, by rebuilding from the recovered keys.
+
+def window_key(k, q, i):
+    """Key i of a curve extended by virtual keys (9.3 "The window"): (frame, q)."""
+    n = len(k)
+    if i < 0:
+        return k[0] + (k[1] - k[0]) * i, q[0]
+    if i >= n:
+        return k[n - 1] + (k[n - 1] - k[n - 2]) * (i - n + 1), q[n - 1]
+    return k[i], q[i]
+
+
+def expected_record(k, q, b, q_base):
+    """What 9.3 defines for block b's record of a curve with keys (k, q)."""
+    lo, hi = 64 * b, 64 * b + 64
+    f = sum(1 for x in k if x < lo)  # the first key at or after the block
+    l = sum(1 for x in k if x < hi)  # one past the block's last key
+    window = [window_key(k, q, i) for i in [f - 2, f - 1] + list(range(f, l)) + [l, l + 1]]
+    e = [window[0][0], window[1][0], window[-2][0], window[-1][0]]
+    ctx = [zigzag(e[0] - lo), zigzag(e[1] - lo), zigzag(e[2] - hi), zigzag(e[3] - hi)]
+    wq = [x[1] for x in window]
+    base = min(wq) - q_base
+    return {"Value_Bits": (max(wq) - min(wq)).bit_length(), "Context_Bits": (ctx[0] | ctx[1] | ctx[2] | ctx[3]).bit_length(),
+            "Context": ctx, "Base": base, "Values": [x - q_base - base for x in wq]}
+
+
+def check_image_content(image):
+    """9.4's content rules: IMAG is the image 9.2 and 9.3 build from the keys it holds."""
+    a, keys = image["arrays"], image["keys"]
+    for i in sorted(keys):
+        frames, qs, values = keys[i]
+        if any(abs(q) > 2 ** 53 for q in qs):
+            raise KanimError("corrupt", f"IMAG: curve {i}: a key's |q| > 2^53")
+        if not all(math.isfinite(v) for v in values):
+            raise KanimError("corrupt", f"IMAG: curve {i}: a key's value is not finite")
+        q_base, _, base_bits, _ = a["Curves"][i]
+        if q_base != min(qs):
+            raise KanimError("corrupt", f"IMAG: Curves[{i}].Q_Base is not the curve's smallest q")
+        if base_bits != (max(qs) - min(qs)).bit_length():
+            raise KanimError("corrupt", f"IMAG: Curves[{i}].Base_Bits")
+        check_curve_ends(a, i, frames, values, with_values=True)
+        for b, rec in enumerate(image["records"].get(i, [])):
+            want = expected_record(frames, qs, b, q_base)
+            for name in ["Value_Bits", "Context_Bits", "Context", "Base", "Values"]:
+                if rec[name] != want[name]:
+                    raise KanimError("corrupt", f"IMAG: record of block {b}, curve {i}: {name} is not what 9.3 makes of the keys")
 
 
 def segment_value(k, v, n, j, u, interp, tension, rule):

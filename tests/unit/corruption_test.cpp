@@ -32,6 +32,7 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
+#include "internal/xxh64.h"
 
 // ---------------------------------------------------------------------------------------------
 // Allocation probe: the largest single allocation while `g_probe_on` is set. Under
@@ -132,7 +133,14 @@ void put_f64(std::vector<uint8_t>& b, double d) {
   put_u64(b, v);
 }
 
+// The checksum of spec 3.3, or of 9.1 (XXH64, 8 bytes) for a runtime-profile file (version 4,
+// Header_Flags bit 0).
 void fix_checksum(std::vector<uint8_t>& f) {
+  if (f.size() >= 24 && f[8] == 4 && f[9] == 0 && (f[12] & 1)) {
+    const uint64_t x = keyanim::internal::xxh64_of(f.data(), f.size() - 8);
+    for (int i = 0; i < 8; ++i) f[f.size() - 8 + size_t(i)] = uint8_t(x >> (8 * i));
+    return;
+  }
   const uint32_t c = crc32_of(f.data(), f.size() - 4);
   for (int i = 0; i < 4; ++i) f[f.size() - 4 + size_t(i)] = uint8_t(c >> (8 * i));
 }

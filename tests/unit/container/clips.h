@@ -377,12 +377,15 @@ inline void check_same_samples(const Clip& a, const Clip& b) {
 // A file builder for crafted files, independent of the writer.
 
 // Version 1.0 files are frozen (written by the 1.0 writer); the current writer makes the rest.
-const char* const kVectorNames[] = {"v1_rules",  "v1_uniform", "v1_single",  "v1_long",   "v2_rules",
+// v4_* are the runtime profile of the v3_* file of the same name (keyanim convert --runtime),
+// and v4_archive is v3_rules as an archive file of version 4.0 (spec/test-vectors/make_v4_archive.py).
+const char* const kVectorNames[] = {"v1_rules",  "v1_uniform", "v1_single",  "v1_long",    "v2_rules",
                                     "v2_long",   "v2_predict", "v3_rules",   "v3_uniform", "v3_single",
-                                    "v3_long",   "v3_predict", "v3_blocks"};
+                                    "v3_long",   "v3_predict", "v3_blocks",  "v4_rules",   "v4_uniform",
+                                    "v4_single", "v4_long",    "v4_predict", "v4_blocks",  "v4_archive"};
 inline EncodedClip vector_clip(const std::string& name) {
   const std::string kind = name.substr(3);
-  if (kind == "rules") return vector_rules();
+  if (kind == "rules" || kind == "archive") return vector_rules();
   if (kind == "uniform") return vector_uniform();
   if (kind == "single") return vector_single();
   if (kind == "predict") return vector_predict();

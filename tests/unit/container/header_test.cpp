@@ -44,7 +44,7 @@ TEST_CASE("crafted headers: signature version flags") {
   CHECK_FAILS(std::vector<uint8_t>({'B', 'V', 'H'}), Status::bad_signature, 0);
   {
     RawFile r = base;
-    r.major = keyanim::kNewestFormatVersionMajor + 1;
+    r.major = keyanim::kNewestFormatVersionMajor + 1;  // 4 is a valid archive version (spec 9)
     CHECK_FAILS(r.build(), Status::unsupported_version, 8);
     r.major = 0;
     CHECK_FAILS(r.build(), Status::unsupported_version, 8);
