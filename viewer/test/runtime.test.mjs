@@ -85,7 +85,21 @@ const cases = {
   'First_Frame of curve 0 off by one': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Frame.at, v.getFloat32(L.arrays.First_Frame.at, true) + 1, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Frame.at },
   'First_Value of curve 0 (a content rule)': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Value.at, 12345, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Value.at },
   'the file one byte longer': { bytes: fixXxh(Uint8Array.from([...base, 0])), status: 'trailing_bytes', where: 'checksum', offset: base.length },
+  // 9.1.1 says "in this order, with nothing between them"; keyanim's C++ table check lets an
+  // ancillary section sit between IMAG and SKEL (cpp: what `keyanim verify` says instead).
+  'an ancillary section between IMAG and SKEL': { bytes: fixXxh(insertAfterImag('XTRA', 2)), status: 'corrupt', where: 'section table', offset: 24 + 48, cpp: 'ok' },
+  'CHAN in a runtime file': { bytes: fixXxh(insertAfterImag('CHAN', 0)), status: 'corrupt', where: 'section table', offset: 24 + 48 },
 };
+
+// A table entry for an empty section `tag` inserted as entry 2, before SKEL.
+function insertAfterImag(tag, flags) {
+  const entry = new Uint8Array(24);
+  entry.set(new TextEncoder().encode(tag));
+  dv(entry).setUint32(4, flags, true);
+  const b = Uint8Array.from([...base.subarray(0, 72), ...entry, ...base.subarray(72)]);
+  dv(b).setUint32(16, dv(base).getUint32(16, true) + 1, true);
+  return b;
+}
 
 // CLIP, SKEL, IMAG: SKEL's bytes move up to entry 1's place, IMAG's after them.
 function swapImagSkel() {
@@ -140,8 +154,8 @@ test('keyanim verify gives the same status and offset on every case', { skip }, 
     fs.writeFileSync(file, c.bytes);
     const r = spawnSync(keyanimCli, ['verify', file], { encoding: 'utf8' });
     const m = /offset (\d+) \(0x[0-9A-Fa-f]+\): ([a-z_]+):/.exec(r.stderr);
-    const cpp = m ? `${m[2]} @${m[1]}` : `exit ${r.status}: ${r.stderr.trim()}`;
-    if (cpp !== `${c.status} @${c.offset}`) mismatches.push(`${name}: C++ ${cpp}, JS ${c.status} @${c.offset}`);
+    const cpp = r.status === 0 ? 'ok' : m ? `${m[2]} @${m[1]}` : `exit ${r.status}: ${r.stderr.trim()}`;
+    if (cpp !== (c.cpp ?? `${c.status} @${c.offset}`)) mismatches.push(`${name}: C++ ${cpp}, JS ${c.status} @${c.offset}`);
   }
   assert.deepEqual(mismatches, []);
 });
