@@ -2,7 +2,7 @@
 // v4_rules.kanim that each break one rule of 9.1 or 9.4 (the XXH64 fixed again unless the
 // checksum is the point), rejected with the rule's status at the field's file offset, the
 // message naming the place as section 7 asks. With the keyanim CLI, `keyanim verify` must
-// agree (status and offset) where the spec leaves it no choice.
+// agree (status and offset), or give what a case's `cpp` states (a known, explained difference).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -73,7 +73,8 @@ const cases = {
   // More of 9.1 and 9.4, and a content rule this decoder checks (First_Value of a block curve).
   'Runtime set in a 3.0 file': { bytes: withCrc32(read('v3_rules.kanim'), (b) => { b[12] = 1; }), status: 'reserved_bits_set', where: 'header', offset: 12 },
   'Runtime clear: IMAG is an unknown critical section': { bytes: patch((b) => { b[12] = 0; }, false), status: 'reserved_bits_set', where: 'section table', offset: L.sections.IMAG.entry },
-  'Context_Bits 32': { bytes: patch((b) => { b[record0 + 9] = 32; }), status: 'corrupt', where: 'section IMAG', offset: record0 + 9 },
+  // keyanim's C++ names the record's Value_Bits byte for either width; section 7 asks for the field's.
+  'Context_Bits 32': { bytes: patch((b) => { b[record0 + 9] = 32; }), status: 'corrupt', where: 'section IMAG', offset: record0 + 9, cpp: `corrupt @${record0 + 8}` },
   'Block_Shift 7': { bytes: patch((b) => { b[L.sections.IMAG.at] = 7; }), status: 'corrupt', where: 'section IMAG', offset: L.sections.IMAG.at },
   'Image_Reserved non-zero': { bytes: patch((b) => { b[L.sections.IMAG.at + 28] = 1; }), status: 'reserved_bits_set', where: 'section IMAG', offset: L.sections.IMAG.at + 24 },
   'Interpolation 2': { bytes: patch((b) => { b[L.arrays.Interpolation.at + 3] = 2; }), status: 'reserved_bits_set', where: 'section IMAG', offset: L.arrays.Interpolation.at + 3 },
@@ -81,9 +82,11 @@ const cases = {
   'Payload_Size one more': { bytes: patch((b, v) => v.setUint32(L.sections.IMAG.at + 20, L.P + 1, true)), status: 'corrupt', where: 'section IMAG', offset: L.sections.IMAG.at + 20 },
   'Payload_Size 8 more (the arrays overrun IMAG)': { bytes: patch((b, v) => v.setUint32(L.sections.IMAG.at + 20, L.P + 8, true)), status: 'corrupt', where: 'section IMAG', offset: L.sections.IMAG.at },
   'a non-zero closing byte of Payload': { bytes: patch((b) => { b[L.arrays.Payload.at + L.P + 3] = 1; }), status: 'corrupt', where: 'section IMAG', offset: L.arrays.Payload.at + L.P + 3 },
-  'Curve_Channel differs from Curve_Of': { bytes: patch((b, v) => v.setUint32(L.arrays.Curve_Channel.at, 99, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.Curve_Channel.at },
+  // The C++ names Curve_Of (the array Curve_Channel is compared with); this decoder the field changed.
+  'Curve_Channel differs from Curve_Of': { bytes: patch((b, v) => v.setUint32(L.arrays.Curve_Channel.at, 99, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.Curve_Channel.at, cpp: `corrupt @${L.arrays.Curve_Of.at}` },
   'First_Frame of curve 0 off by one': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Frame.at, v.getFloat32(L.arrays.First_Frame.at, true) + 1, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Frame.at },
-  'First_Value of curve 0 (a content rule)': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Value.at, 12345, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Value.at },
+  // The C++ rebuilds the whole image and names IMAG's start; this decoder rebuilds field by field.
+  'First_Value of curve 0 (a content rule)': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Value.at, 12345, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Value.at, cpp: `corrupt @${L.sections.IMAG.at}` },
   'the file one byte longer': { bytes: fixXxh(Uint8Array.from([...base, 0])), status: 'trailing_bytes', where: 'checksum', offset: base.length },
   // 9.1.1 says "in this order, with nothing between them"; keyanim's C++ table check lets an
   // ancillary section sit between IMAG and SKEL (cpp: what `keyanim verify` says instead).
