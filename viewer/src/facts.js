@@ -7,7 +7,7 @@ export function clipFacts(clip, original) {
   const joints = clip.nodes.filter((n) => !n.endSite).length;
   const rawF32 = clip.frameCount * clip.channelCount * 4;
   const rows = [
-    ['format', `.kanim ${clip.version.major}.${clip.version.minor}`],
+    ['format', `.kanim ${clip.version.major}.${clip.version.minor}, ${clip.profile} profile`],
     ['frames', `${clip.frameCount}`],
     ['fps', clip.frameTime > 0 ? fmt(1 / clip.frameTime, 5) : '-'],
     ['duration', clip.frameTime > 0 ? `${fmt(Math.max(0, clip.frameCount - 1) * clip.frameTime, 4)} s` : '-'],

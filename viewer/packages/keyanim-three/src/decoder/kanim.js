@@ -1,17 +1,20 @@
 // The .kanim decoder, written from spec/FORMAT.md alone: container (sections 1-3), the CLIP,
 // SKEL, CHAN, KTIM and NOTE sections (4), the checks of sections 5-8, in the order section 7
-// recommends. Versions 3.0 and, by Appendix E, 1.0 and 2.0. Key values: kval.js;
-// sampling (Appendix A): sample.js.
+// recommends. Archive files of versions 3.0 and 4.0 and, by Appendix E, 1.0 and 2.0; runtime
+// files of 4.0 (section 9: table rules in table-rules.js, IMAG in imag.js). Key values:
+// kval.js; sampling (Appendix A): sample.js.
 import { fail, KanimError } from './errors.js';
 import { SectionReader } from './reader.js';
 import { crc32 } from './crc32.js';
+import { xxh64 } from './xxh64.js';
+import { archiveRules, runtimeRules } from './table-rules.js';
+import { decodeImage } from './imag.js';
 import { decompressSection, isZstdFailure } from './zstd.js';
 import { decodeKeyValues } from './kval.js';
 
 export { KanimError };
 
 const SIGNATURE = [0x89, 0x4b, 0x41, 0x4e, 0x0d, 0x0a, 0x1a, 0x0a];
-const CRITICAL = ['CLIP', 'SKEL', 'CHAN', 'KTIM', 'KVAL'];
 export const CHANNEL_TYPES = ['Xposition', 'Yposition', 'Zposition', 'Xrotation', 'Yrotation', 'Zrotation'];
 export const MAX_FRAMES_V3 = 2 ** 24;
 
@@ -44,19 +47,22 @@ export function nodeLabel(nodes, i) {
 // Decodes and validates a whole file. Returns the clip (see makeClip) or throws KanimError.
 export function decodeKanim(input, limits = DEFAULT_LIMITS) {
   const bytes = input instanceof Uint8Array ? input : new Uint8Array(input);
-  const { version, sections } = readContainer(bytes, limits);
-  const clip = makeClip(version, bytes.length, sections);
+  const { version, profile, sections } = readContainer(bytes, limits);
+  const clip = makeClip(version, profile, bytes.length, sections);
+  const parsers = PARSERS[profile];
   for (const s of sections) {
-    const parse = SECTION_PARSERS[s.tag];
+    const parse = parsers[s.tag];
     if (!parse) continue;  // an ancillary section of a later minor version
     parse(new SectionReader(s.tag, sectionContent(bytes, s), s.offset, s.compressed), clip, limits);
   }
+  if (profile === 'runtime') nameChannels(clip);
   return clip;
 }
 
-function makeClip(version, fileBytes, sections) {
+// profile: 'archive' (sections 2-8) or 'runtime' (section 9); either gives the same clip.
+function makeClip(version, profile, fileBytes, sections) {
   return {
-    version, fileBytes,
+    version, profile, fileBytes,
     sections: sections.map(({ tag, compressed, storedSize, rawSize }) => ({ tag, compressed, storedSize, rawSize })),
     frameCount: 0, frameTime: 0, tangentRule: 0, nodeCount: 0, channelCount: 0, keyCount: 0,
     nodes: [], channels: [], notes: '',
@@ -73,41 +79,54 @@ function readContainer(bytes, limits) {
   if (bytes.length < 24) fail('truncated', 'header', bytes.length, 'the file ends inside the header');
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const major = view.getUint16(8, true), minor = view.getUint16(10, true);
-  if (major < 1 || major > 3) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 3)`);
-  if (view.getUint32(12, true) & 0xffff) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  if (major < 1 || major > 4) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 4)`);
+  const flags = view.getUint32(12, true);
+  // Bit 0 is Runtime in version 4 (spec 2.2), reserved before; bits 1-15 are reserved.
+  if (flags & (major === 4 ? 0xfffe : 0xffff)) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  const profile = major === 4 && (flags & 1) ? 'runtime' : 'archive';
+  const checksumBytes = profile === 'runtime' ? 8 : 4;  // XXH64 (9.1.3) or CRC-32 (3.3)
   const count = view.getUint32(16, true);
   if (view.getUint32(20, true) !== 0) fail('reserved_bits_set', 'header', 20, 'Header_Reserved is not 0');
   const tableEnd = 24 + 24 * count;
   if (bytes.length < tableEnd) fail('truncated', 'section table', bytes.length, `the file ends inside the table of ${count} sections`);
 
-  const sections = readTable(bytes, view, count);
-  checkLength(bytes.length, tableEnd, sections);
+  const parsers = PARSERS[profile];
+  const sections = readTable(bytes, view, count, profile === 'runtime' ? runtimeRules() : archiveRules(), checksumBytes);
+  checkLength(bytes.length, tableEnd, sections, checksumBytes);
   let raw = 0n;
   for (const s of sections) {
-    if (SECTION_PARSERS[s.tag]) raw += s.rawSize;
+    if (parsers[s.tag]) raw += s.rawSize;
     if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `the sections decode to ${raw} bytes or more, above the limit of ${limits.rawBytes}`);
     if (s.tag === 'NOTE' && s.rawSize > BigInt(limits.noteBytes ?? DEFAULT_LIMITS.noteBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `NOTE declares ${s.rawSize} bytes, above the limit of ${limits.noteBytes ?? DEFAULT_LIMITS.noteBytes} (notes are informative text)`);
   }
   sections.forEach((s, i) => {
-    if (SECTION_PARSERS[s.tag] && s.compressed && s.rawSize > BigInt(MAX_ZSTD_EXPANSION) * s.storedSize)
+    if (parsers[s.tag] && s.compressed && s.rawSize > BigInt(MAX_ZSTD_EXPANSION) * s.storedSize)
       fail('zstd_error', 'section table', s.entry + 16, `section ${i} (${s.tag}): Raw_Size ${s.rawSize} is more than its ${s.storedSize} stored bytes can make (a zstd frame makes at most ${MAX_ZSTD_EXPANSION} bytes of each)`);
   });
-  const stored = view.getUint32(bytes.length - 4, true), computed = crc32(bytes.subarray(0, bytes.length - 4));
-  if (stored !== computed) fail('checksum_mismatch', 'checksum', bytes.length - 4, `CRC-32 is 0x${hex8(computed)}, the file says 0x${hex8(stored)}`);
-  return { version: { major, minor }, sections };
+  checkChecksum(bytes, view, profile);
+  return { version: { major, minor }, profile, sections };
 }
 
-const hex8 = (v) => v.toString(16).padStart(8, '0');
+const hex = (v, digits) => v.toString(16).padStart(digits, '0');
+
+function checkChecksum(bytes, view, profile) {
+  if (profile === 'runtime') {
+    const at = bytes.length - 8, stored = view.getBigUint64(at, true), computed = xxh64(bytes.subarray(0, at));
+    if (stored !== computed) fail('checksum_mismatch', 'checksum', at, `XXH64 is 0x${hex(computed, 16)}, the file says 0x${hex(stored, 16)}`);
+    return;
+  }
+  const at = bytes.length - 4, stored = view.getUint32(at, true), computed = crc32(bytes.subarray(0, at));
+  if (stored !== computed) fail('checksum_mismatch', 'checksum', at, `CRC-32 is 0x${hex(computed, 8)}, the file says 0x${hex(stored, 8)}`);
+}
 
 function tagName(b) {
   const printable = [...b].every((c) => c >= 0x20 && c < 0x7f);
   return printable ? String.fromCharCode(...b) : [...b].map((c) => c.toString(16).padStart(2, '0')).join(' ');
 }
 
-// Section 3.1 and rules 3.2.2 to 3.2.4, entry by entry.
-function readTable(bytes, view, count) {
+// Section 3.1 and rules 3.2.2 to 3.2.4 (9.1.1 in the runtime profile: `rules`), entry by entry.
+function readTable(bytes, view, count, rules, checksumBytes) {
   const sections = [];
-  let nextCritical = 0, notes = 0;
   let offset = 24n + 24n * BigInt(count);
   for (let i = 0; i < count; ++i) {
     const e = 24 + 24 * i;
@@ -116,30 +135,21 @@ function readTable(bytes, view, count) {
     const flags = view.getUint32(e + 4, true);
     if (flags & 0xfffc) fail('reserved_bits_set', 'section table', e + 4, `${where}: reserved Section_Flags bits are set`);
     const compressed = (flags & 1) !== 0, ancillary = (flags & 2) !== 0;
-    const critical = CRITICAL.indexOf(tag);
-    if (critical >= 0) {
-      if (ancillary) fail('corrupt', 'section table', e + 4, `${where}: ${tag} must be critical (Ancillary clear)`);
-      if (critical !== nextCritical) fail('corrupt', 'section table', e, `${where}: ${nextCritical < CRITICAL.length ? `expected ${CRITICAL[nextCritical]}` : `${tag} again`} (the critical sections come once each, in the order ${CRITICAL.join(', ')})`);
-      ++nextCritical;
-    } else if (tag === 'NOTE') {
-      if (!ancillary) fail('corrupt', 'section table', e + 4, `${where}: NOTE must be ancillary`);
-      if (++notes > 1) fail('corrupt', 'section table', e, `${where}: a second NOTE section`);
-    } else if (!ancillary) {
-      fail('reserved_bits_set', 'section table', e, `${where}: unknown critical section`);
-    }
+    rules.entry({ index: i, tag, compressed, ancillary, entry: e, where });
     const storedSize = view.getBigUint64(e + 8, true), rawSize = view.getBigUint64(e + 16, true);
     if (!compressed && rawSize !== storedSize) fail('corrupt', 'section table', e + 8, `${where}: Raw_Size ${rawSize} differs from Stored_Size ${storedSize} in an uncompressed section`);
     sections.push({ tag, compressed, ancillary, storedSize, rawSize, offset, entry: e });
     offset += storedSize;
-    if (offset + 4n > BigInt(bytes.length)) fail('truncated', 'section table', bytes.length, `${where}: the file ends before the section's declared end`);
+    if (offset + BigInt(checksumBytes) > BigInt(bytes.length)) fail('truncated', 'section table', bytes.length, `${where}: the file ends before the section's declared end`);
   }
-  if (nextCritical < CRITICAL.length) fail('corrupt', 'section table', 24, `no ${CRITICAL[nextCritical]} section`);
+  rules.end();
   return sections;
 }
 
-// Rule 3.2.1: the file is exactly 28 + 24 n + the stored sizes (BigInt: no overflow).
-function checkLength(length, tableEnd, sections) {
-  const want = sections.reduce((sum, s) => sum + s.storedSize, BigInt(tableEnd) + 4n);
+// Rule 3.2.1: the file is exactly 28 + 24 n + the stored sizes (32 + ... in the runtime
+// profile, 9.1.3; BigInt: no overflow).
+function checkLength(length, tableEnd, sections, checksumBytes) {
+  const want = sections.reduce((sum, s) => sum + s.storedSize, BigInt(tableEnd) + BigInt(checksumBytes));
   if (BigInt(length) < want) fail('truncated', 'section table', length, `the file holds ${length} bytes, the table declares ${want}`);
   if (BigInt(length) > want) fail('trailing_bytes', 'checksum', Number(want), `${BigInt(length) - want} bytes follow the checksum`);
   for (const s of sections) s.offset = Number(s.offset);
@@ -160,7 +170,7 @@ function sectionContent(bytes, s) {
 
 function parseClip(r, clip, limits) {
   if (r.length !== 32) r.fail('corrupt', 0, `CLIP holds ${r.length} bytes, not 32`);
-  const v3 = clip.version.major === 3;
+  const v3 = clip.version.major >= 3;  // 3.0 and 4.0 (both profiles)
   const frames = r.u32();
   if (v3 && frames > MAX_FRAMES_V3) r.fail('corrupt', 0, `Frame_Count ${frames} is above 2^24`);
   if (frames > limits.frames) r.fail('limit_exceeded', 0, `Frame_Count ${frames} is above the limit of ${limits.frames}`);
@@ -225,7 +235,7 @@ function parseSkel(r, clip) {
 
 function parseChan(r, clip) {
   const c = clip.channelCount, major = clip.version.major;
-  const perChannel = { 1: 17, 2: 18, 3: 19 }[major];
+  const perChannel = { 1: 17, 2: 18, 3: 19, 4: 19 }[major];
   if (r.length !== perChannel * c) r.fail('corrupt', 0, `CHAN holds ${r.length} bytes, not ${perChannel} x ${c}`);
   const channels = [];
   clip.nodes.forEach((node, n) => node.channels.forEach((type) => channels.push({ node: n, type })));
@@ -283,4 +293,13 @@ function parseNote(r, clip) {
   clip.notes = new TextDecoder('utf-8').decode(r.bytes);
 }
 
-const SECTION_PARSERS = { CLIP: parseClip, SKEL: parseSkel, CHAN: parseChan, KTIM: parseKtim, KVAL: decodeKeyValues, NOTE: parseNote };
+// IMAG (9.2) comes before SKEL: it fills clip.channels without their nodes, named here.
+function nameChannels(clip) {
+  clip.nodes.forEach((node, n) => node.channels.forEach((type, k) => Object.assign(clip.channels[node.firstChannel + k], { node: n, type })));
+}
+
+// The sections each profile decodes (and counts for rule 3.2.6); any other is skipped.
+const PARSERS = {
+  archive: { CLIP: parseClip, SKEL: parseSkel, CHAN: parseChan, KTIM: parseKtim, KVAL: decodeKeyValues, NOTE: parseNote },
+  runtime: { CLIP: parseClip, IMAG: decodeImage, SKEL: parseSkel, NOTE: parseNote },
+};

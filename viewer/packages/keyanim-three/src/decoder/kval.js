@@ -1,5 +1,6 @@
-// KVAL (spec 4.5, and Appendix E for 1.0 and 2.0): residuals -> quantized values q -> key
-// values v = RN32(q x Step). q can reach 2^53 and residuals 2^57, so they are BigInts.
+// KVAL (spec 4.5, of 3.0 and 4.0 archive files; Appendix E for 1.0 and 2.0): residuals ->
+// quantized values q -> key values v = RN32(q x Step). q can reach 2^53 and residuals 2^57,
+// so they are BigInts.
 
 const TWO53 = 2n ** 53n, TWO57 = 2n ** 57n, TWO54 = 2n ** 54n, TWO40 = 2n ** 40n;
 const abs = (x) => (x < 0n ? -x : x);
@@ -10,7 +11,7 @@ const floorDiv = (a, b) => { const q = a / b; return a % b < 0n ? q - 1n : q; };
 
 export function decodeKeyValues(r, clip) {
   const major = clip.version.major;
-  const next = major === 3 ? fixedWidthResiduals(r, clip.channels) : varintPlaneResiduals(r, clip.keyCount);
+  const next = major >= 3 ? fixedWidthResiduals(r, clip.channels) : varintPlaneResiduals(r, clip.keyCount);
   const rBound = major === 1 ? TWO54 : TWO57;
   clip.channels.forEach((ch, c) => {
     const frames = ch.keyFrames, values = new Float32Array(ch.keyCount);

@@ -1,5 +1,6 @@
-// XXH64 with seed 0 (the zstd frame checksum is its low 32 bits, RFC 8878 3.1.1). BigInt
-// arithmetic: only frames that carry a checksum pay for it, and keyanim writes none.
+// XXH64 with seed 0, from xxHash's doc/xxhash_spec.md: the runtime profile's file checksum
+// (spec 9.1.3), and in its low 32 bits the zstd frame checksum (RFC 8878 3.1.1). BigInt
+// arithmetic: exact and short; a runtime file is hashed once, as it is loaded.
 const M = (1n << 64n) - 1n;
 const P1 = 11400714785074694791n, P2 = 14029467366897019727n, P3 = 1609587929392839161n;
 const P4 = 9650029242287828579n, P5 = 2870177450012600261n;
@@ -8,7 +9,7 @@ const rotl = (x, r) => ((x << r) | (x >> (64n - r))) & M;
 const round = (acc, lane) => (rotl((acc + lane * P2) & M, 31n) * P1) & M;
 const merge = (acc, v) => (((acc ^ round(0n, v)) * P1) & M) + P4 & M;
 
-export function xxh64Low32(bytes) {
+export function xxh64(bytes) {
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const n = bytes.length;
   let at = 0, h;
@@ -34,6 +35,7 @@ export function xxh64Low32(bytes) {
   for (; at < n; ++at) h = (rotl(h ^ ((BigInt(bytes[at]) * P5) & M), 11n) * P1) & M;
   h ^= h >> 33n; h = (h * P2) & M;
   h ^= h >> 29n; h = (h * P3) & M;
-  h ^= h >> 32n;
-  return Number(h & 0xffffffffn);
+  return h ^ (h >> 32n);
 }
+
+export const xxh64Low32 = (bytes) => Number(xxh64(bytes) & 0xffffffffn);
