@@ -8,6 +8,7 @@
 
 #include "common.h"
 #include "dense_clip.h"
+#include "keyanim/offline/container.h"
 #include "keyanim/offline/guarded_read.h"
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/error.h"
@@ -60,7 +61,9 @@ std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
   py::gil_scoped_release unlocked;
   if (c->file) bytes = offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
   ErrorInfo info;
-  if (Clip::load(bytes, c->clip, &info, {}, rigs) != Status::ok) {
+  DecodeLimits limits;
+  limits.check_content = true;  // a runtime-profile file is checked as thoroughly as an archive one
+  if (Clip::load(bytes, c->clip, &info, limits, rigs) != Status::ok) {
     // A BVH file given where a .kanim goes: say where it goes instead of "bad signature".
     if (starts_like_bvh(bytes))
       throw offline::Error(offline::ErrorKind::malformed,
@@ -188,6 +191,33 @@ void register_clip(py::module_& m) {
       "largest magnitude; angles are unwrapped (consecutive frames differ by less than 180\n"
       "degrees) as the encoder unwraps them.");
   cls.def_property_readonly("frame_count", [](const PyClip& c) { return c.clip.frame_count(); }, "Number of source frames.");
+  cls.def_property_readonly("profile", [](const PyClip& c) { return c.clip.runtime_profile() ? "runtime" : "archive"; },
+                            "The file's profile (spec/FORMAT.md section 9): 'archive' (entropy-coded, the smallest) or\n"
+                            "'runtime' (the image a player samples in place).");
+  cls.def(
+      "runtime_bytes",
+      [](const PyClip& c) {
+        std::vector<uint8_t> b;
+        {
+          py::gil_scoped_release unlocked;
+          b = offline::write_kanim_runtime(c.clip);
+        }
+        return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
+      },
+      "The clip as a runtime-profile .kanim (format 4.0), which samples to the same values bit for\n"
+      "bit: what `keyanim convert --runtime` writes.");
+  cls.def(
+      "archive_bytes",
+      [](const PyClip& c) {
+        std::vector<uint8_t> b;
+        {
+          py::gil_scoped_release unlocked;
+          b = offline::write_kanim(offline::encoded_clip(c.clip));
+        }
+        return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
+      },
+      "The clip as an archive-profile .kanim (format 3.0): `keyanim convert --archive`. The same\n"
+      "keys and values; a constant channel's single key is stored as +-1 x |value|.");
   cls.def_property_readonly("frame_time", [](const PyClip& c) { return c.clip.frame_time(); }, "Seconds between frames.");
   cls.def_property_readonly("fps", [](const PyClip& c) { return fps_of(c.clip.frame_time()); },
                             "Frames per second, 1 / frame_time (None without a frame time).");

@@ -74,7 +74,7 @@ const cases = {
   'Runtime set in a 3.0 file': { bytes: withCrc32(read('v3_rules.kanim'), (b) => { b[12] = 1; }), status: 'reserved_bits_set', where: 'header', offset: 12 },
   'Runtime clear: IMAG is an unknown critical section': { bytes: patch((b) => { b[12] = 0; }, false), status: 'reserved_bits_set', where: 'section table', offset: L.sections.IMAG.entry },
   // keyanim's C++ names the record's Value_Bits byte for either width; section 7 asks for the field's.
-  'Context_Bits 32': { bytes: patch((b) => { b[record0 + 9] = 32; }), status: 'corrupt', where: 'section IMAG', offset: record0 + 9, cpp: `corrupt @${record0 + 8}` },
+  'Context_Bits 32': { bytes: patch((b) => { b[record0 + 9] = 32; }), status: 'corrupt', where: 'section IMAG', offset: record0 + 9 },
   'Block_Shift 7': { bytes: patch((b) => { b[L.sections.IMAG.at] = 7; }), status: 'corrupt', where: 'section IMAG', offset: L.sections.IMAG.at },
   'Image_Reserved non-zero': { bytes: patch((b) => { b[L.sections.IMAG.at + 28] = 1; }), status: 'reserved_bits_set', where: 'section IMAG', offset: L.sections.IMAG.at + 24 },
   'Interpolation 2': { bytes: patch((b) => { b[L.arrays.Interpolation.at + 3] = 2; }), status: 'reserved_bits_set', where: 'section IMAG', offset: L.arrays.Interpolation.at + 3 },
@@ -88,9 +88,8 @@ const cases = {
   // The C++ rebuilds the whole image and names IMAG's start; this decoder rebuilds field by field.
   'First_Value of curve 0 (a content rule)': { bytes: patch((b, v) => v.setFloat32(L.arrays.First_Value.at, 12345, true)), status: 'corrupt', where: 'section IMAG', offset: L.arrays.First_Value.at, cpp: `corrupt @${L.sections.IMAG.at}` },
   'the file one byte longer': { bytes: fixXxh(Uint8Array.from([...base, 0])), status: 'trailing_bytes', where: 'checksum', offset: base.length },
-  // 9.1.1 says "in this order, with nothing between them"; keyanim's C++ table check lets an
-  // ancillary section sit between IMAG and SKEL (cpp: what `keyanim verify` says instead).
-  'an ancillary section between IMAG and SKEL': { bytes: fixXxh(insertAfterImag('XTRA', 2)), status: 'corrupt', where: 'section table', offset: 24 + 48, cpp: 'ok' },
+  // 9.1.1: SKEL is entry 2, so nothing sits between IMAG and SKEL.
+  'an ancillary section between IMAG and SKEL': { bytes: fixXxh(insertAfterImag('XTRA', 2)), status: 'corrupt', where: 'section table', offset: 24 + 48 },
   'CHAN in a runtime file': { bytes: fixXxh(insertAfterImag('CHAN', 0)), status: 'corrupt', where: 'section table', offset: 24 + 48 },
 };
 

@@ -193,8 +193,10 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
       uint64_t mask;
       std::memcpy(&mask, rec, 8);
       const uint32_t vw = rec[8], kw = rec[9];
-      if (vw > kMaxValueBits || kw > kMaxContextBits)
-        return fail_in(Status::corrupt, c, payload_at + running + 8, "record " + std::to_string(r) + ": Value_Bits above 55 or Context_Bits above 31");
+      if (vw > kMaxValueBits)
+        return fail_in(Status::corrupt, c, payload_at + running + 8, "record " + std::to_string(r) + ": Value_Bits above 55");
+      if (kw > kMaxContextBits)
+        return fail_in(Status::corrupt, c, payload_at + running + 9, "record " + std::to_string(r) + ": Context_Bits above 31");
       if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, "record " + std::to_string(r) + ": a key at or after Frame_Count");
       const uint32_t wc = load_le<uint32_t>(c.data + lay.at[L::curves] + uint64_t(kCurveBytes) * i + 16);
       const uint32_t m = static_cast<uint32_t>(__builtin_popcountll(mask));

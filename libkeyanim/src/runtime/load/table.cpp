@@ -86,11 +86,14 @@ Status Loader::read_header_and_table() {
     if (runtime_ && crit == critical_count && e.tag != internal::kTagNote)  // whatever its flags
       for (uint32_t tag : internal::kCriticalTags)
         if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
+    if (runtime_ && i < critical_count && e.tag != critical_tags[i])
+      return fail(Status::corrupt, "table", e.entry_offset,
+                  name + ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2");
     if (crit < critical_count) {
       if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
-      if (crit != next_critical || (runtime_ && crit < 2 && i != crit))
+      if (crit != next_critical || (runtime_ && i != crit))
         return fail(Status::corrupt, "table", e.entry_offset,
-                    name + (runtime_ ? ": the runtime profile's sections must be CLIP (entry 0), IMAG (entry 1), SKEL, once each"
+                    name + (runtime_ ? ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2"
                                      : ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order"));
       critical_index_[crit] = static_cast<int>(i);
       ++next_critical;

@@ -34,10 +34,10 @@ export function archiveRules() {
   };
 }
 
-// 9.1.1: CLIP, IMAG, SKEL at entries 0, 1, 2, then NOTE or not, with nothing between; unknown
-// ancillary sections only after those; nothing compressed; no section of the archive profile.
+// 9.1.1: CLIP, IMAG, SKEL at entries 0, 1, 2; after them at most one NOTE and unknown
+// ancillary sections, in any order; nothing compressed; no section of the archive profile.
 export function runtimeRules() {
-  let count = 0;
+  let count = 0, notes = 0;
   return {
     entry(e) {
       ++count;
@@ -50,8 +50,7 @@ export function runtimeRules() {
       } else if (RUNTIME_SECTIONS.includes(e.tag)) {
         fail('corrupt', 'section table', e.entry, `${e.where}: ${e.tag} again`);
       } else if (e.tag === 'NOTE') {
-        if (e.index !== RUNTIME_SECTIONS.length) fail('corrupt', 'section table', e.entry, `${e.where}: NOTE must follow SKEL directly (entry 3)`);
-        checkNote(e, false);
+        checkNote(e, notes++ > 0);
       } else if (!e.ancillary) {
         fail('reserved_bits_set', 'section table', e.entry, `${e.where}: unknown critical section`);
       }
