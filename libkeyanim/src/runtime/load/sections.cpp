@@ -68,43 +68,43 @@ Status Loader::parse_skel(const Content& c, ClipSource& parts) {
   uint64_t channel_sum = 0;
   for (uint32_t i = 0; i < node_count_; ++i) {
     Joint& j = joints[i];
-    const std::string node = "node " + std::to_string(i) + ": ";
+    auto node = [i] { return "node " + std::to_string(i) + ": "; };  // built only for a message
     const size_t start = r.pos();
     uint32_t name_len = 0;
     const uint8_t* name = nullptr;
     if (!r.read(name_len) || !r.bytes(name_len, name))
-      return fail_in(Status::corrupt, c, start, node + "the name runs past the end of SKEL");
+      return fail_in(Status::corrupt, c, start, node() + "the name runs past the end of SKEL");
     j.name.assign(reinterpret_cast<const char*>(name), name_len);
     const size_t fixed = r.pos();
     if (r.remaining() < internal::kNodeFixedBytes - 4)
-      return fail_in(Status::corrupt, c, fixed, node + "the record runs past the end of SKEL");
+      return fail_in(Status::corrupt, c, fixed, node() + "the record runs past the end of SKEL");
     uint8_t flags = 0, count = 0;
     r.read(j.parent);
     for (double& o : j.offset) r.read(o);
     r.read(flags);
     r.read(count);
     if (j.parent < -1 || (j.parent >= 0 && static_cast<uint32_t>(j.parent) >= i))
-      return fail_in(Status::corrupt, c, fixed, node + "Parent must be -1 or an earlier node");
+      return fail_in(Status::corrupt, c, fixed, node() + "Parent must be -1 or an earlier node");
     if (j.parent >= 0 && joints[static_cast<size_t>(j.parent)].end_site)
-      return fail_in(Status::corrupt, c, fixed, node + "the parent is an End Site");
+      return fail_in(Status::corrupt, c, fixed, node() + "the parent is an End Site");
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(j.offset[static_cast<size_t>(k)]))
-        return fail_in(Status::corrupt, c, fixed + 4 + 8 * static_cast<size_t>(k), node + "Offset is not finite");
+        return fail_in(Status::corrupt, c, fixed + 4 + 8 * static_cast<size_t>(k), node() + "Offset is not finite");
     if (flags & internal::kNodeReservedMask)
-      return fail_in(Status::reserved_bits_set, c, fixed + 28, node + "reserved Node_Flags bits are set");
+      return fail_in(Status::reserved_bits_set, c, fixed + 28, node() + "reserved Node_Flags bits are set");
     j.end_site = (flags & internal::kNodeEndSite) != 0;
-    if (j.end_site && j.parent < 0) return fail_in(Status::corrupt, c, fixed, node + "an End Site must have a parent");
+    if (j.end_site && j.parent < 0) return fail_in(Status::corrupt, c, fixed, node() + "an End Site must have a parent");
     if (count > internal::kMaxNodeChannels)
-      return fail_in(Status::corrupt, c, fixed + 29, node + "more than 6 channels");
-    if (j.end_site && count != 0) return fail_in(Status::corrupt, c, fixed + 29, node + "an End Site has channels");
+      return fail_in(Status::corrupt, c, fixed + 29, node() + "more than 6 channels");
+    if (j.end_site && count != 0) return fail_in(Status::corrupt, c, fixed + 29, node() + "an End Site has channels");
     const uint8_t* types = nullptr;
     if (!r.bytes(count, types))
-      return fail_in(Status::corrupt, c, fixed + 30, node + "the channel list runs past the end of SKEL");
+      return fail_in(Status::corrupt, c, fixed + 30, node() + "the channel list runs past the end of SKEL");
     j.channels.resize(count);
     for (uint32_t k = 0; k < count; ++k) {
       if (types[k] > internal::kMaxChannelType)
         return fail_in(Status::reserved_bits_set, c, fixed + 30 + k,
-                       node + "reserved channel type " + std::to_string(types[k]));
+                       node() + "reserved channel type " + std::to_string(types[k]));
       j.channels[k] = static_cast<ChannelType>(types[k]);
     }
     channel_sum += count;
