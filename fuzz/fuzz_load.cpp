@@ -1,8 +1,9 @@
 // Fuzz target: the .kanim loader (Clip::load) on arbitrary bytes.
 // Each input is loaded twice: as given (almost always stopped by a check of the header, the
-// table or the checksum) and with its trailing CRC-32 recomputed, so that mutations reach the
-// section parsers. Checks: no crash, no read outside the input, no hang, no allocation beyond
-// what the limits and the data justify (run with -malloc_limit_mb); a failure leaves the clip
+// table or the checksum) and with its trailing checksum recomputed (the CRC-32, or a runtime-
+// profile file's XXH64), so that mutations reach the section parsers and the image checks.
+// Checks: no crash, no read outside the input, no hang, no allocation beyond what the limits
+// and the data justify (run with -malloc_limit_mb); a failure leaves the clip
 // empty with an error naming a section and an offset inside the file; a success gives arrays
 // that keep every promise the sampler relies on (key frames strictly increasing and below
 // frame_count, finite key values, tracks covering the key arrays, channels = skeleton's).
@@ -32,7 +33,7 @@ keyanim::DecodeLimits fuzz_limits() {
 }
 
 void check_loaded(const Clip& clip) {
-  FUZZ_CHECK(clip.version_major() >= keyanim::kOldestFormatVersionMajor && clip.version_major() <= keyanim::kFormatVersionMajor);
+  FUZZ_CHECK(clip.version_major() >= keyanim::kOldestFormatVersionMajor && clip.version_major() <= keyanim::kNewestFormatVersionMajor);
   const uint32_t channels = clip.channel_count();
   FUZZ_CHECK(clip.skeleton().channel_count() == channels);
   FUZZ_CHECK(std::isfinite(clip.frame_time()) && clip.frame_time() >= 0.0);

@@ -15,9 +15,6 @@
 //  * Clip::load with check_content: a failure is `corrupt` in IMAG; a success means the image
 //    is the one its keys make, so the viewed clip must then sample, with or without a cursor,
 //    bit for bit as the loaded clip and as eval_channel (cardinal.h, Appendix A) on its keys.
-#define XXH_INLINE_ALL  // xxHash compiled in, as the library does (no libxxhash to link)
-#include <xxhash.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -45,22 +42,6 @@ keyanim::DecodeLimits fuzz_limits(bool check_content) {
   l.max_decompressed_bytes = 64u << 20;
   l.check_content = check_content;
   return l;
-}
-
-bool is_runtime_profile(const uint8_t* p, size_t size) {
-  if (size < 24) return false;
-  uint16_t major;
-  uint32_t flags;
-  std::memcpy(&major, p + 8, 2);
-  std::memcpy(&flags, p + 12, 4);
-  return major >= 4 && (flags & 1u) != 0;
-}
-
-// The last 8 bytes set to the XXH64 (seed 0) of every byte before them (section 9.1, rule 3).
-void fix_xxh64(uint8_t* p, size_t size) {
-  if (size < 32) return;
-  const uint64_t h = XXH64(p, size - 8, 0);
-  for (int i = 0; i < 8; ++i) p[size - 8 + static_cast<size_t>(i)] = static_cast<uint8_t>(h >> (8 * i));
 }
 
 void check_failure(Status s, const ErrorInfo& err, const Clip& clip, size_t size) {
@@ -205,7 +186,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint64_t> words(size / 8 + 1);  // 8-aligned, as Clip::view needs
   uint8_t* bytes = reinterpret_cast<uint8_t*>(words.data());
   if (size > 0) std::memcpy(bytes, data, size);
-  if (is_runtime_profile(bytes, size)) fix_xxh64(bytes, size);
+  if (keyanim::fuzz::is_runtime_profile(bytes, size)) keyanim::fuzz::fix_checksum(bytes, size);
   const std::span<const uint8_t> in(bytes, size);
 
   Clip viewed, loaded;
@@ -231,7 +212,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const Status cs = Clip::load(in, checked, &cerr, fuzz_limits(true));
   if (cs != Status::ok) {
     // Only the runtime profile has content rules beyond what loading already checks.
-    FUZZ_CHECK(cs == Status::corrupt && cerr.section == "IMAG" && is_runtime_profile(bytes, size));
+    FUZZ_CHECK(cs == Status::corrupt && cerr.section == "IMAG" && keyanim::fuzz::is_runtime_profile(bytes, size));
     check_failure(cs, cerr, checked, size);
     return 0;
   }
