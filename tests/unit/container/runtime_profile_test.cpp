@@ -575,6 +575,14 @@ TEST_CASE("runtime profile: a content-rule break passes the structure checks and
     CHECK(c.err.section == "IMAG");
     CHECK(c.err.byte_offset == f.imag);
     CHECK(c.clip.channel_count() == 0);
+    // view with check_content rebuilds the image as load does, and refuses it the same way.
+    DecodeLimits checking;
+    checking.check_content = true;
+    Clip vc;
+    ErrorInfo vce;
+    CHECK(Clip::view(a.span(), vc, &vce, checking) == Status::corrupt);
+    CHECK(vce.section == "IMAG");
+    CHECK(vc.channel_count() == 0);
     // The flip reached a key: exactly one key value of the viewed clip differs from the file's.
     const uint64_t curve_ch = get_le(good, f.at[RuntimeFile::curve_channel] + 4 * (i % f.nb), 4);
     uint64_t differing = 0;
@@ -634,6 +642,29 @@ TEST_CASE("runtime profile: lifetime of a clip's bytes (clip.h)") {
       CHECK(keyanim::test::channel_keys(loaded, ch).values == keyanim::test::channel_keys(reference.clip, ch).values);
       break;
     }
+  }
+  SUBCASE("a viewed clip holds none of the file's bytes; a loaded one holds a copy of them") {
+    Aligned a(good);
+    Clip viewed, loaded;
+    REQUIRE(Clip::view(a.span(), viewed) == Status::ok);
+    REQUIRE(Clip::load(good, loaded) == Status::ok);
+    // Both count the image they sample; the loaded clip's is inside the copy of the whole file
+    // it holds, the viewed clip's is IMAG in the caller's bytes.
+    const RuntimeFile f(good);
+    CHECK(viewed.skeleton_bytes() == loaded.skeleton_bytes());
+    CHECK(loaded.animation_bytes() - viewed.animation_bytes() == good.size() - (f.imag_end() - f.imag));
+  }
+  SUBCASE("clips viewed and loaded through one RigCache share its rig") {
+    keyanim::RigCache rigs;
+    Aligned a(good), b(good);
+    Clip first, second, archive;
+    REQUIRE(Clip::view(a.span(), first, nullptr, {}, &rigs) == Status::ok);
+    REQUIRE(Clip::view(b.span(), second, nullptr, {}, &rigs) == Status::ok);
+    REQUIRE(Clip::load(read_file(vector_path("v3_rules", ".kanim")), archive, nullptr, {}, &rigs) == Status::ok);
+    CHECK(rigs.rig_count() == 1);
+    CHECK(first.shares_rig(second));
+    CHECK(first.shares_rig(archive));
+    check_same_everything(archive, second);
   }
   SUBCASE("view of an archive file decodes it: the clip does not use the bytes after view returns") {
     Clip viewed;
