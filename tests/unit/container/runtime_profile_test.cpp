@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -598,6 +599,35 @@ TEST_CASE("runtime profile: a content-rule break passes the structure checks and
     CHECK(differing == 1);
   }
   REQUIRE(done);
+}
+
+TEST_CASE("runtime profile: a Step whose values overflow binary32 is a content break (fuzz_load's crash-runtime-infinite-step)") {
+  // Section 9.4: Step need only be finite and > 0 for the structure; "every v is finite" is a
+  // content rule. A structure-valid file with infinite values samples (to whatever) without
+  // harm, and check_content refuses it.
+  std::vector<uint8_t> b = v4_rules();
+  const RuntimeFile f(b);
+  REQUIRE(f.nb >= 1);
+  put_le(b, f.at[RuntimeFile::curves] + 8, 8, std::bit_cast<uint64_t>(1e300));
+  fix_xxh64(b);
+  Aligned a(b);
+  const Loaded v = view(a), l = load(b), c = load(b, true);
+  REQUIRE(v.status == Status::ok);
+  CHECK(l.status == Status::ok);
+  CHECK(c.status == Status::corrupt);
+  CHECK(c.err.section == "IMAG");
+  const uint32_t ch = uint32_t(get_le(b, f.at[RuntimeFile::curve_channel], 4));
+  const auto keys = keyanim::test::channel_keys(v.clip, ch);
+  REQUIRE(!keys.values.empty());
+  CHECK(std::any_of(keys.values.begin(), keys.values.end(), [](float x) { return !std::isfinite(x); }));
+  std::vector<float> out(v.clip.channel_count());
+  std::vector<Transform> pose(v.clip.skeleton().joints.size());
+  Cursor cursor;
+  REQUIRE(cursor.prepare(v.clip) == Status::ok);
+  for (double x = -1.0; x <= v.clip.frame_count() + 1.0; x += 0.25) {
+    CHECK(v.clip.sample(x, out, &cursor) == Status::ok);
+    CHECK(v.clip.sample_model(x, pose) == Status::ok);
+  }
 }
 
 TEST_CASE("runtime profile: lifetime of a clip's bytes (clip.h)") {
