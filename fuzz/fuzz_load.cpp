@@ -1,11 +1,16 @@
 // Fuzz target: the .kanim loader (Clip::load) on arbitrary bytes.
 // Each input is loaded twice: as given (almost always stopped by a check of the header, the
-// table or the checksum) and with its trailing CRC-32 recomputed, so that mutations reach the
-// section parsers. Checks: no crash, no read outside the input, no hang, no allocation beyond
-// what the limits and the data justify (run with -malloc_limit_mb); a failure leaves the clip
+// table or the checksum) and with its trailing checksum recomputed (the CRC-32, or a runtime-
+// profile file's XXH64), so that mutations reach the section parsers and the image checks.
+// Checks: no crash, no read outside the input, no hang, no allocation beyond what the limits
+// and the data justify (run with -malloc_limit_mb); a failure leaves the clip
 // empty with an error naming a section and an offset inside the file; a success gives arrays
 // that keep every promise the sampler relies on (key frames strictly increasing and below
 // frame_count, finite key values, tracks covering the key arrays, channels = skeleton's).
+// A runtime-profile file (spec section 9) is checked for its structure only, unless
+// DecodeLimits::check_content: its key values may then be infinite (a Step of 1e300, say),
+// which section 9.4 leaves to the content rules. Such a file is loaded a second time with
+// check_content, and only a clip that passes it must have finite key values.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -25,13 +30,15 @@ using keyanim::Status;
 
 // Smaller than the defaults so that a tiny zstd frame cannot make every run decompress 1 GiB;
 // the checks are the same code whatever the numbers.
-keyanim::DecodeLimits fuzz_limits() {
+keyanim::DecodeLimits fuzz_limits(bool check_content = false) {
   keyanim::DecodeLimits l;
   l.max_decompressed_bytes = 64u << 20;
+  l.check_content = check_content;
   return l;
 }
 
-void check_loaded(const Clip& clip) {
+// `finite`: whether the key values must be finite (all but an unchecked runtime profile).
+void check_loaded(const Clip& clip, bool finite) {
   FUZZ_CHECK(clip.version_major() >= keyanim::kOldestFormatVersionMajor && clip.version_major() <= keyanim::kNewestFormatVersionMajor);
   const uint32_t channels = clip.channel_count();
   FUZZ_CHECK(clip.skeleton().channel_count() == channels);
@@ -54,7 +61,7 @@ void check_loaded(const Clip& clip) {
     for (size_t i = 0; i < k.frames.size(); ++i) {
       FUZZ_CHECK(k.frames[i] < clip.frame_count());
       if (i > 0) FUZZ_CHECK(k.frames[i] > k.frames[i - 1]);
-      FUZZ_CHECK(std::isfinite(k.values[i]));
+      if (finite) FUZZ_CHECK(std::isfinite(k.values[i]));
     }
   }
   FUZZ_CHECK(keys == clip.total_keys());
@@ -70,7 +77,13 @@ void load_once(std::span<const uint8_t> bytes) {
   const Status s = Clip::load(bytes, clip, &err, fuzz_limits());
   if (s == Status::ok) {
     FUZZ_CHECK(err.status == Status::ok);
-    check_loaded(clip);
+    const bool runtime = keyanim::fuzz::is_runtime_profile(bytes.data(), bytes.size());
+    check_loaded(clip, !runtime);
+    if (!runtime) return;
+    Clip checked;
+    const Status c = Clip::load(bytes, checked, &err, fuzz_limits(true));
+    FUZZ_CHECK(c == Status::ok || (c == Status::corrupt && err.section == "IMAG"));
+    if (c == Status::ok) check_loaded(checked, true);
     return;
   }
   FUZZ_CHECK(err.status == s);

@@ -2,12 +2,16 @@
 """Regenerates the seed files of fuzz/corpus/ (the committed ones were made by this script).
 
 usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
+       fuzz/make_seeds.py --view KEYANIM_BINARY   (view/ alone, from the committed load/ seeds)
 
  - bvh/:       tests/data/bvh fixtures, data/*.bvh and CMU clips of the shared corpus cut to 3 frames
  - roundtrip/: a settings byte + BVH snippets of at most 2000 values (see fuzz_roundtrip.cpp)
  - load/:      spec/test-vectors/*.kanim and .kanim files encoded (by KEYANIM_BINARY) from snippets,
                each also with its sections stored uncompressed (zstd CLI)
  - sample/:    request records + those .kanim files (see fuzz_sample.cpp); fuzz_c_api reads them too
+ - view/:      view_seeds(): spec/test-vectors/v4_*.kanim (the runtime profile) and the runtime
+               profile (keyanim convert --runtime) of load/'s CMU seeds, those encoded at the
+               default error and at 1% with uniform:5 keys (the _raw ones are the same clips)
  - c_api/:     c_api_seeds(): a few of sample/'s seeds with every fuzz_c_api request kind, loaded
                with the CRC-32 as given (byte 0 >= 231): intact, a byte flipped, cut short
 
@@ -131,6 +135,22 @@ def main() -> None:
             records += bytes([m]) + struct.pack("<d", rng.uniform(-5, 60))
         write(os.path.join(corpus, "sample", key + ".bin"), bytes([16]) + records + data)
     c_api_seeds(corpus)
+    view_seeds(keyanim, corpus)
+
+
+def view_seeds(keyanim, corpus):
+    """fuzz_view's seeds: runtime-profile files (see fuzz_view.cpp)."""
+    vectors = os.path.join(ROOT, "spec", "test-vectors")
+    for name in sorted(os.listdir(vectors)):
+        if name.startswith("v4_") and name.endswith(".kanim"):
+            with open(os.path.join(vectors, name), "rb") as f:
+                write(os.path.join(corpus, "view", "vector_" + name), f.read())
+    load = os.path.join(corpus, "load")
+    for name in sorted(os.listdir(load)):
+        if re.fullmatch(r"cmu_[0-9a-z_-]+?(_coarse)?\.kanim", name) and "_raw" not in name:
+            dst = os.path.join(corpus, "view", name[:-6] + "_runtime.kanim")
+            subprocess.run([keyanim, "-q", "-f", "convert", os.path.join(load, name), "--runtime", "-o", dst],
+                           check=True)
 
 
 def c_api_seeds(corpus):
@@ -152,4 +172,7 @@ def c_api_seeds(corpus):
 
 
 if __name__ == "__main__":
-    main()
+    if len(sys.argv) == 3 and sys.argv[1] == "--view":
+        view_seeds(sys.argv[2], os.path.join(HERE, "corpus"))
+    else:
+        main()

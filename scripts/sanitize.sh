@@ -80,7 +80,7 @@ fuzz() {
 }
 # One target per core.
 status=0
-for pair in "bvh load" "sample roundtrip" "c_api"; do
+for pair in "bvh load" "sample roundtrip" "c_api view"; do
   pids=()
   for t in $pair; do fuzz "$t" & pids+=($!); done
   for p in "${pids[@]}"; do wait "$p" || status=1; done

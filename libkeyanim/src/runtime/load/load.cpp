@@ -88,8 +88,9 @@ Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t>
                     ErrorInfo* err) {
   const uint64_t keys = loader.key_count();
   const std::span<const uint8_t> imag = loader.image();
-  out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage),
-                                              storage ? bytes.size() : 0, rigs));
+  // Before the call: an argument list may move `storage` before it reads it (clang does).
+  const size_t held = storage ? bytes.size() : 0;
+  out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage), held, rigs));
   if (!limits.check_content) return Status::ok;
   const Status s = out.check_content(err);
   if (s != Status::ok) {
