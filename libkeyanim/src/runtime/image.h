@@ -141,8 +141,11 @@ std::shared_ptr<const Image> build_image(ClipSource&& source, RigCache* rigs = n
 // The image of a runtime-profile file whose IMAG passed the structure checks (load/): `facts`
 // holds its CLIP, SKEL and NOTE (no keys), `imag` points into `storage` (or into caller-owned
 // bytes when `storage` is null: Clip::view).
+// With `rig` (found in `rigs` by the file's SKEL bytes, `skel`), `facts` holds no skeleton;
+// else its skeleton is interned in `rigs` (if any), which then remembers `skel`.
 std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys, std::span<const uint8_t> imag,
-                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs);
+                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs,
+                                        std::shared_ptr<const Rig> rig, std::span<const uint8_t> skel);
 // The keys `img` holds (spec section 9.3), as a source (image_keys.cpp). A single key comes back
 // as q = +-1 and step = |value| (the image keeps only its value): the same key, bit for bit.
 ClipSource image_keys(const Image& img);

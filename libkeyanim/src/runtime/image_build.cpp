@@ -333,15 +333,18 @@ Arrays build_arrays(const ClipSource& src) {
   return a;
 }
 
-// The clip's facts, rig and notes (not its arrays), from a source or a checked file.
-std::shared_ptr<Image> image_of(ClipSource& src, RigCache* rigs) {
+// The clip's facts, rig and notes (not its arrays), from a source or a checked file; the rig is
+// `rig` if given, else the source's skeleton (interned in `rigs` if given).
+std::shared_ptr<Image> image_of(ClipSource& src, RigCache* rigs, std::shared_ptr<const Rig> rig = nullptr) {
   auto img = std::make_shared<Image>();
   img->version_major = src.version_major;
   img->version_minor = src.version_minor;
   img->frame_count = src.frame_count;
   img->frame_time = src.frame_time;
   img->rule = src.rule;
-  img->rig = rigs != nullptr ? RigCacheAccess::intern(*rigs, std::move(src.skeleton)) : make_rig(std::move(src.skeleton));
+  img->rig = rig != nullptr    ? std::move(rig)
+             : rigs != nullptr ? RigCacheAccess::intern(*rigs, std::move(src.skeleton))
+                               : make_rig(std::move(src.skeleton));
   img->notes = std::move(src.notes);
   static std::atomic<uint64_t> next_id{1};
   img->id = next_id.fetch_add(1, std::memory_order_relaxed);
@@ -360,9 +363,12 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
 }
 
 std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys, std::span<const uint8_t> imag,
-                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs) {
-  const uint32_t channels = static_cast<uint32_t>(facts.skeleton.channel_count());
-  std::shared_ptr<Image> img = image_of(facts, rigs);
+                                        std::shared_ptr<const void> storage, size_t held_bytes, RigCache* rigs,
+                                        std::shared_ptr<const Rig> rig, std::span<const uint8_t> skel) {
+  const bool found = rig != nullptr;
+  const uint32_t channels = static_cast<uint32_t>(found ? rig->skeleton.channel_count() : facts.skeleton.channel_count());
+  std::shared_ptr<Image> img = image_of(facts, rigs, std::move(rig));
+  if (!found && rigs != nullptr) RigCacheAccess::remember_skel(*rigs, img->rig, skel);
   img->total_keys = total_keys;
   img->storage = std::move(storage);
   img->held_bytes = held_bytes;

@@ -7,6 +7,9 @@
 #include <cstring>
 #include <mutex>
 #include <unordered_map>
+#include <vector>
+
+#include "internal/xxh64.h"
 
 #include "keyanim/clip.h"
 #include "runtime/rig_cache_access.h"
@@ -137,6 +140,13 @@ namespace keyanim {
 struct RigCache::State {
   mutable std::mutex mutex;
   mutable std::unordered_multimap<uint64_t, std::weak_ptr<const internal::Rig>> rigs;
+  // The same rigs by the XXH64 of a runtime-profile file's SKEL bytes, with those bytes: a
+  // file whose SKEL equals one seen finds its rig without parsing it (spec section 9).
+  struct BySkel {
+    std::weak_ptr<const internal::Rig> rig;
+    std::vector<uint8_t> skel;
+  };
+  mutable std::unordered_multimap<uint64_t, BySkel> by_skel;
 };
 
 RigCache::RigCache() : state_(std::make_unique<State>()) {}
@@ -145,6 +155,7 @@ RigCache::~RigCache() = default;
 size_t RigCache::rig_count() const noexcept {
   const std::lock_guard<std::mutex> lock(state_->mutex);
   std::erase_if(state_->rigs, [](const auto& e) { return e.second.expired(); });
+  std::erase_if(state_->by_skel, [](const auto& e) { return e.second.rig.expired(); });
   return state_->rigs.size();
 }
 
@@ -169,6 +180,30 @@ std::shared_ptr<const Rig> RigCacheAccess::intern(RigCache& cache, Skeleton&& sk
   std::shared_ptr<const Rig> rig = make_rig(std::move(skeleton));
   st.rigs.emplace(h, rig);
   return rig;
+}
+
+std::shared_ptr<const Rig> RigCacheAccess::find_skel(RigCache& cache, std::span<const uint8_t> skel) {
+  const uint64_t h = xxh64_of(skel.data(), skel.size());
+  RigCache::State& st = *cache.state_;
+  const std::lock_guard<std::mutex> lock(st.mutex);
+  auto [it, end] = st.by_skel.equal_range(h);
+  while (it != end) {
+    std::shared_ptr<const Rig> rig = it->second.rig.lock();
+    if (rig == nullptr) {
+      it = st.by_skel.erase(it);
+      continue;
+    }
+    if (std::equal(skel.begin(), skel.end(), it->second.skel.begin(), it->second.skel.end())) return rig;
+    ++it;
+  }
+  return nullptr;
+}
+
+void RigCacheAccess::remember_skel(RigCache& cache, const std::shared_ptr<const Rig>& rig, std::span<const uint8_t> skel) {
+  const uint64_t h = xxh64_of(skel.data(), skel.size());
+  RigCache::State& st = *cache.state_;
+  const std::lock_guard<std::mutex> lock(st.mutex);
+  st.by_skel.emplace(h, RigCache::State::BySkel{rig, {skel.begin(), skel.end()}});
 }
 
 }  // namespace keyanim::internal

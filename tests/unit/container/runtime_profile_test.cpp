@@ -497,7 +497,7 @@ TEST_CASE("runtime profile: IMAG's structure rules (9.2, 9.3) broken one at a ti
   }
   SUBCASE("a record's Context_Bits 32") {
     const Record r = record_of(good, f, 0, 0);
-    check_refused(broken(r.at + 9, 1, 32), Status::corrupt, "IMAG", r.at + 8);
+    check_refused(broken(r.at + 9, 1, 32), Status::corrupt, "IMAG", r.at + 9);  // the field itself
   }
   SUBCASE("a Mask bit at Frame_Count") {
     REQUIRE(f.frames % 64 != 0);

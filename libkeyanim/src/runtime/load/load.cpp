@@ -9,10 +9,13 @@
 #include <utility>
 #include <vector>
 
+#include "internal/byte_reader.h"
+#include "internal/format.h"
 #include "keyanim/clip.h"
 #include "runtime/clip_access.h"
 #include "runtime/image.h"
 #include "runtime/load/loader.h"
+#include "runtime/rig_cache_access.h"
 
 namespace keyanim {
 namespace internal {
@@ -59,8 +62,12 @@ Status Loader::run_runtime(ClipSource& parts) {
   if (s == Status::ok) s = parse_clip(c, parts);
   if (s == Status::ok) s = get_content(table_[1], "IMAG", imag_);
   if (s == Status::ok) s = check_image(imag_, parts);
-  if (s == Status::ok) s = get_content(table_[static_cast<size_t>(critical_index_[2])], "SKEL", c);
-  if (s == Status::ok) s = parse_skel(c, parts);
+  if (s == Status::ok) s = get_content(table_[static_cast<size_t>(critical_index_[2])], "SKEL", skel_);
+  if (s == Status::ok && rigs_ != nullptr) rig_ = RigCacheAccess::find_skel(*rigs_, skel());
+  // Equal SKEL bytes were parsed and checked once; CLIP's counts must still agree with them.
+  if (rig_ != nullptr && (rig_->skeleton.joints.size() != node_count_ || rig_->skeleton.channel_count() != channel_count_))
+    rig_ = nullptr;
+  if (s == Status::ok && rig_ == nullptr) s = parse_skel(skel_, parts);
   if (s == Status::ok && note_index_ >= 0) {
     s = get_content(table_[static_cast<size_t>(note_index_)], "NOTE", c);
     if (s == Status::ok) parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);
@@ -81,6 +88,14 @@ Status out_of_memory(Clip& out, ErrorInfo* err) {
   return Status::limit_exceeded;
 }
 
+// Whether the header says the runtime profile (spec section 9: version 4 or later, Runtime set);
+// the loader checks everything else.
+bool says_runtime(std::span<const uint8_t> bytes) noexcept {
+  if (bytes.size() < internal::kHeaderEnd) return false;
+  return internal::load_le<uint16_t>(bytes.data() + 8) >= internal::kRuntimeVersionMajor &&
+         (internal::load_le<uint32_t>(bytes.data() + 12) & internal::kHeaderRuntime) != 0;
+}
+
 // A runtime-profile file whose structure passed: its image over `bytes` (which `storage` owns,
 // or the caller), then the content rules if asked for.
 Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t> bytes,
@@ -90,7 +105,8 @@ Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t>
   const std::span<const uint8_t> imag = loader.image();
   // Before the call: an argument list may move `storage` before it reads it (clang does).
   const size_t held = storage ? bytes.size() : 0;
-  out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage), held, rigs));
+  out = ClipAccess::make(internal::view_image(std::move(parts), keys, imag, std::move(storage), held, rigs,
+                                              loader.rig(), loader.skel()));
   if (!limits.check_content) return Status::ok;
   const Status s = out.check_content(err);
   if (s != Status::ok) {
@@ -107,23 +123,24 @@ Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
   out = Clip{};
   if (err != nullptr) *err = ErrorInfo{};
   try {
-    ClipSource parts;
-    Loader loader(bytes, limits, err);
-    const Status s = loader.run(parts);
-    if (s != Status::ok) return s;
-    if (!loader.runtime()) {
+    if (!says_runtime(bytes)) {
+      ClipSource parts;
+      Loader loader(bytes, limits, err);
+      const Status s = loader.run(parts);
+      if (s != Status::ok) return s;
       out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
       return Status::ok;
     }
-    // The runtime profile: the file's bytes copied to 8-aligned memory the clip owns, and
-    // viewed there (checked again: cheap, and the spans must point into the copy).
+    // The runtime profile: the file's bytes copied to 8-aligned memory the clip owns (no more
+    // than the caller already holds), then checked and viewed there.
     auto words = std::shared_ptr<uint64_t[]>(new uint64_t[(bytes.size() + 7) / 8]);
     std::memcpy(words.get(), bytes.data(), bytes.size());
     const std::span<const uint8_t> copy(reinterpret_cast<const uint8_t*>(words.get()), bytes.size());
     ClipSource facts;
-    Loader again(copy, limits, err);
-    if (const Status c = again.run(facts); c != Status::ok) return c;
-    return runtime_clip(again, std::move(facts), copy, std::move(words), limits, rigs, out, err);
+    Loader loader(copy, limits, err);
+    loader.use_rigs(rigs);
+    if (const Status c = loader.run(facts); c != Status::ok) return c;
+    return runtime_clip(loader, std::move(facts), copy, std::move(words), limits, rigs, out, err);
   } catch (const std::bad_alloc&) {
     return out_of_memory(out, err);
   }
@@ -155,6 +172,7 @@ Status Clip::view(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, con
   try {
     ClipSource parts;
     Loader loader(bytes, limits, err);
+    loader.use_rigs(rigs);
     const Status s = loader.run(parts);
     if (s != Status::ok) return s;
     if (!loader.runtime()) {  // an archive file is decoded: the clip then needs `bytes` no more

@@ -15,6 +15,7 @@
 #include "internal/value_coding.h"
 #include "keyanim/clip.h"
 #include "runtime/image_layout.h"
+#include "runtime/rig.h"
 
 namespace keyanim::internal {
 
@@ -52,6 +53,11 @@ class Loader {
   // into `parts` (no keys), IMAG checked (section 9.4's structure rules) and left in image().
   Status run(ClipSource& parts);  // load.cpp
   bool runtime() const noexcept { return runtime_; }
+  // The runtime profile with a rig cache: a SKEL the cache has seen is not parsed; its rig is
+  // rig() (else null, and the parsed skeleton is in `parts`). skel(): SKEL's bytes.
+  void use_rigs(RigCache* rigs) noexcept { rigs_ = rigs; }
+  const std::shared_ptr<const Rig>& rig() const noexcept { return rig_; }
+  std::span<const uint8_t> skel() const noexcept { return {skel_.data, skel_.size}; }
   uint64_t key_count() const noexcept { return key_count_; }
   std::span<const uint8_t> image() const noexcept { return {imag_.data, imag_.size}; }
 
@@ -113,6 +119,9 @@ class Loader {
   uint16_t minor_ = 0;
   bool runtime_ = false;  // the runtime profile (Header_Flags bit 0, version 4)
   Content imag_;          // its IMAG, once checked
+  Content skel_;          // its SKEL
+  RigCache* rigs_ = nullptr;
+  std::shared_ptr<const Rig> rig_;
   std::vector<TableEntry> table_;
   int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL (runtime: CLIP, IMAG, SKEL)
   int note_index_ = -1;
