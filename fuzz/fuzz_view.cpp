@@ -207,6 +207,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FUZZ_CHECK(same_transforms(sv.poses, sl.poses));
   FUZZ_CHECK(same_floats(sv.playback, sl.playback));
 
+  // Through a rig cache that lives across inputs: a SKEL seen before (in another input, maybe
+  // with other CLIP counts) is found by its bytes, not parsed; the clip must be the same.
+  static keyanim::RigCache rigs;
+  {
+    Clip shared, again;
+    FUZZ_CHECK(Clip::view(in, shared, nullptr, fuzz_limits(false), &rigs) == Status::ok);
+    FUZZ_CHECK(Clip::view(in, again, nullptr, fuzz_limits(false), &rigs) == Status::ok);
+    FUZZ_CHECK(again.shares_rig(shared) && shared.rig_hash() == viewed.rig_hash());
+    FUZZ_CHECK(shared.skeleton().joints.size() == viewed.skeleton().joints.size());
+    const Samples ss = sample_all(again);
+    FUZZ_CHECK(same_floats(sv.values, ss.values));
+    FUZZ_CHECK(same_transforms(sv.poses, ss.poses));
+  }
+  rigs.rig_count();  // drops the expired entries: the cache stays small
+
   Clip checked;
   ErrorInfo cerr;
   const Status cs = Clip::load(in, checked, &cerr, fuzz_limits(true));
