@@ -6,6 +6,9 @@
 # KEYANIM_SKIP_SANITIZE=1 leaves that out: the quick variant).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache (scripts/configure.sh) names sources relative to the checkout, so that two clones (CI's,
+# then scripts/newcomer.sh's fresh one) share what the first compiled.
+export CCACHE_BASEDIR=$PWD
 start=$SECONDS
 scripts/configure.sh build -DCMAKE_BUILD_TYPE=Release -DKEYANIM_BUILD_TESTS=ON -DKEYANIM_BUILD_BENCH=ON
 cmake --build build -j"$(nproc)"

@@ -244,7 +244,7 @@ std::vector<std::filesystem::path> test_vectors() {
   return v;
 }
 
-// The byte positions the loops below damage: all of a small file; of a large one (v4_blocks,
+// The byte positions the loops below damage (or cut a file at): all of a small file; of a large one (v4_blocks,
 // 245 KB of runtime profile) the first 2 KB (header, table, IMAG's header and first arrays),
 // the last 64 bytes and every 251st byte between, so that a loop stays linear, not quadratic, in
 // the vectors' bytes (fuzz_view covers the runtime profile's bytes at random).
@@ -319,6 +319,7 @@ TEST_CASE("test vectors: every truncation and appended bytes") {
     const std::vector<uint8_t> file = read_bytes(path);
     INFO(path.filename().string());
     for (size_t n = 0; n < file.size(); ++n) {
+      if (!damaged_position(n, file.size())) continue;  // every length of a small file
       const std::vector<uint8_t> cut(file.begin(), file.begin() + std::ptrdiff_t(n));
       CHECK_MESSAGE(load_fails(cut) == Status::truncated, "length " << n);
     }
