@@ -185,7 +185,7 @@ WrittenBank write_bank(const std::vector<BankInput>& clips, const BankOptions& o
   if (options.runtime) {
     out.bytes = assemble_bank(clips, p, true);
   } else {
-    // With the dictionary and, unless it is to be kept anyway, without: the smaller is kept.
+    // With the dictionary and without (so that its gain is known): `automatic` keeps the smaller.
     std::vector<uint8_t> with, plain;
     Parts d = p;
     if (options.dictionary != BankDictionary::never) d.dictionary = train_dictionary(raw);
@@ -193,11 +193,9 @@ WrittenBank write_bank(const std::vector<BankInput>& clips, const BankOptions& o
       d.members = archive_members(raw, d.dictionary);
       with = assemble_bank(clips, d, false);
     }
-    if (with.empty() || options.dictionary == BankDictionary::automatic) {
-      p.members = archive_members(raw, {});
-      plain = assemble_bank(clips, p, false);
-    }
-    const bool keep = !with.empty() && (plain.empty() || with.size() < plain.size());
+    p.members = archive_members(raw, {});
+    plain = assemble_bank(clips, p, false);
+    const bool keep = !with.empty() && (options.dictionary == BankDictionary::always || with.size() < plain.size());
     out.bytes_without_dictionary = keep ? plain.size() : 0;
     out.dictionary_bytes = keep ? d.dictionary.size() : 0;
     out.bytes = keep ? std::move(with) : std::move(plain);

@@ -33,7 +33,7 @@ struct WrittenBank {
   std::vector<uint8_t> bytes;
   uint32_t skeletons = 0;
   uint64_t dictionary_bytes = 0;           // 0: none
-  uint64_t bytes_without_dictionary = 0;   // the same bank without one (0 if not made: runtime, never)
+  uint64_t bytes_without_dictionary = 0;   // with a dictionary: the same bank without one
 };
 
 // The bank of `clips`, in this order (its clip table's; names are also indexed in byte order).
