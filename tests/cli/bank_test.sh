@@ -83,7 +83,7 @@ refusals)
 import struct, sys
 b = bytearray(open(sys.argv[1], 'rb').read())
 clips, skels = struct.unpack_from('<II', b, 16)
-off, size = struct.unpack_from('<QQ', b, 40 + 16 * skels + 40 * 0)  # clip 0: cmu/walk
+off, size = struct.unpack_from('<QQ', b, 40 + 32 * skels + 40 * 0)  # clip 0: cmu/walk
 b[off + size - 20] ^= 0x40
 open('bad.kbank', 'wb').write(b)
 PY

@@ -9,7 +9,9 @@
 namespace keyanim::internal {
 
 inline constexpr size_t kBankHeaderSize = 40;
-inline constexpr size_t kBankSkeletonEntrySize = 16;  // Offset, Size
+inline constexpr size_t kBankSkeletonEntrySize = 32;  // Offset, Stored_Size, Raw_Size, Skeleton_Flags, reserved
+inline constexpr uint32_t kSkeletonCompressed = 1u << 0;     // Skeleton_Flags
+inline constexpr uint32_t kSkeletonReservedMask = 0x0000FFFEu;
 inline constexpr size_t kBankClipEntrySize = 40;      // Offset, Size, Frame_Time, Frame_Count, Skeleton, Name_Offset, Name_Size
 inline constexpr size_t kBankOrderEntrySize = 4;
 inline constexpr size_t kBankChecksumSize = 8;  // XXH64

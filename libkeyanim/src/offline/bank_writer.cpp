@@ -38,22 +38,31 @@ void drop_skel(std::vector<S>& sections) {
   std::erase_if(sections, [](const S& s) { return s.tag == internal::kTagSkel; });
 }
 
-// A dictionary trained on every section zstd will compress (CHAN, KTIM, KVAL, NOTE), or none
-// when zstd cannot train one (too few or too small samples).
-std::vector<uint8_t> train_dictionary(const std::vector<std::vector<RawSection>>& members) {
-  std::vector<uint8_t> samples;
+// The samples a dictionary is trained on: every section zstd will compress (CHAN, KTIM, KVAL,
+// NOTE), concatenated, and their sizes.
+struct Samples {
+  std::vector<uint8_t> bytes;
   std::vector<size_t> sizes;
+};
+
+Samples samples_of(const std::vector<std::vector<RawSection>>& members) {
+  Samples out;
   for (const auto& m : members)
     for (const RawSection& s : m)
       if (s.z.level > 0 && !s.bytes.empty()) {
-        samples.insert(samples.end(), s.bytes.begin(), s.bytes.end());
-        sizes.push_back(s.bytes.size());
+        out.bytes.insert(out.bytes.end(), s.bytes.begin(), s.bytes.end());
+        out.sizes.push_back(s.bytes.size());
       }
-  // zstd's advice: a dictionary of about a tenth of the samples, at most 100 KB or so.
-  const size_t capacity = std::clamp<size_t>(samples.size() / 10, 256, 112640);
+  return out;
+}
+
+// A dictionary of at most `capacity` bytes, or none when zstd cannot train one (too few or too
+// small samples).
+std::vector<uint8_t> train_dictionary(const Samples& samples, size_t capacity) {
+  if (samples.sizes.size() < 8) return {};
   std::vector<uint8_t> dict(capacity);
-  if (sizes.size() < 8) return {};
-  const size_t n = ZDICT_trainFromBuffer(dict.data(), dict.size(), samples.data(), sizes.data(), static_cast<unsigned>(sizes.size()));
+  const size_t n = ZDICT_trainFromBuffer(dict.data(), dict.size(), samples.bytes.data(), samples.sizes.data(),
+                                         static_cast<unsigned>(samples.sizes.size()));
   if (ZDICT_isError(n)) return {};
   dict.resize(n);
   return dict;
@@ -79,7 +88,7 @@ std::vector<std::vector<uint8_t>> archive_members(const std::vector<std::vector<
 void pad(std::vector<uint8_t>& out) { out.resize(next_part(out.size()), 0); }
 
 struct Parts {
-  std::vector<std::vector<uint8_t>> skeletons;
+  std::vector<Section> skeletons;  // stored as write_kanim stores SKEL (10.3: compressed or not)
   std::vector<uint32_t> skeleton_of;  // per clip
   std::vector<std::vector<uint8_t>> members;
   std::vector<uint8_t> dictionary;
@@ -98,7 +107,7 @@ std::vector<uint8_t> assemble_bank(const std::vector<BankInput>& clips, const Pa
   // Every part's offset, in layout order: skeletons, the checksum, then members.
   uint64_t end = l.dictionary_end;
   std::vector<uint64_t> skel_at, member_at;
-  for (const auto& s : p.skeletons) skel_at.push_back(next_part(end)), end = skel_at.back() + s.size();
+  for (const auto& s : p.skeletons) skel_at.push_back(next_part(end)), end = skel_at.back() + s.stored.size();
   const uint64_t checksum_at = next_part(end);
   end = checksum_at + internal::kBankChecksumSize;
   for (const auto& m : p.members) member_at.push_back(next_part(end)), end = member_at.back() + m.size();
@@ -112,7 +121,13 @@ std::vector<uint8_t> assemble_bank(const std::vector<BankInput>& clips, const Pa
   put_le<uint32_t>(out, static_cast<uint32_t>(p.skeletons.size()));
   put_le<uint64_t>(out, names.size());
   put_le<uint64_t>(out, p.dictionary.size());
-  for (size_t s = 0; s < p.skeletons.size(); ++s) put_le<uint64_t>(out, skel_at[s]), put_le<uint64_t>(out, p.skeletons[s].size());
+  for (size_t s = 0; s < p.skeletons.size(); ++s) {
+    put_le<uint64_t>(out, skel_at[s]);
+    put_le<uint64_t>(out, p.skeletons[s].stored.size());
+    put_le<uint64_t>(out, p.skeletons[s].raw_size);
+    put_le<uint32_t>(out, (p.skeletons[s].flags & internal::kSectionCompressed) ? internal::kSkeletonCompressed : 0u);
+    put_le<uint32_t>(out, 0);  // Skeleton_Reserved
+  }
   for (size_t i = 0; i < clips.size(); ++i) {
     put_le<uint64_t>(out, member_at[i]);
     put_le<uint64_t>(out, p.members[i].size());
@@ -129,7 +144,7 @@ std::vector<uint8_t> assemble_bank(const std::vector<BankInput>& clips, const Pa
   internal::put_bytes(out, names.data(), names.size());
   pad(out);
   internal::put_bytes(out, p.dictionary.data(), p.dictionary.size());
-  for (const auto& s : p.skeletons) pad(out), internal::put_bytes(out, s.data(), s.size());
+  for (const auto& s : p.skeletons) pad(out), internal::put_bytes(out, s.stored.data(), s.stored.size());
   pad(out);
   put_le<uint64_t>(out, internal::xxh64_of(out.data(), out.size()));
   for (const auto& m : p.members) pad(out), internal::put_bytes(out, m.data(), m.size());
@@ -155,17 +170,19 @@ WrittenBank write_bank(const std::vector<BankInput>& clips, const BankOptions& o
   check_names(clips);
   Parts p;
   std::unordered_multimap<uint64_t, uint32_t> skeleton_index;  // XXH64 of SKEL's bytes -> skeleton
+  std::vector<std::vector<uint8_t>> skeletons;                 // their contents
   std::vector<std::vector<RawSection>> raw;
   for (const BankInput& c : clips) {
     // Skeletons are shared when their SKEL bytes are equal (the rig hash's fields, exactly).
     std::vector<uint8_t> skel = skel_section(c.clip.skeleton);
     const uint64_t hash = internal::xxh64_of(skel.data(), skel.size());
-    uint32_t index = static_cast<uint32_t>(p.skeletons.size());
+    uint32_t index = static_cast<uint32_t>(skeletons.size());
     for (auto [it, end] = skeleton_index.equal_range(hash); it != end; ++it)
-      if (p.skeletons[it->second] == skel) index = it->second;
-    if (index == p.skeletons.size()) {
+      if (skeletons[it->second] == skel) index = it->second;
+    if (index == skeletons.size()) {
       skeleton_index.emplace(hash, index);
-      p.skeletons.push_back(std::move(skel));
+      p.skeletons.push_back(stored_skel(skel));
+      skeletons.push_back(std::move(skel));
     }
     p.skeleton_of.push_back(index);
     try {
@@ -185,20 +202,28 @@ WrittenBank write_bank(const std::vector<BankInput>& clips, const BankOptions& o
   if (options.runtime) {
     out.bytes = assemble_bank(clips, p, true);
   } else {
-    // With the dictionary and without (so that its gain is known): `automatic` keeps the smaller.
-    std::vector<uint8_t> with, plain;
-    Parts d = p;
-    if (options.dictionary != BankDictionary::never) d.dictionary = train_dictionary(raw);
-    if (!d.dictionary.empty()) {
-      d.members = archive_members(raw, d.dictionary);
-      with = assemble_bank(clips, d, false);
-    }
+    // Without a dictionary, and with one of each of a few sizes (what pays depends on how much
+    // the clips share: on the corpus' Bandai clips a 46 KB dictionary cost more than it saved):
+    // the smallest bank is kept (`always`: the smallest with a dictionary).
     p.members = archive_members(raw, {});
-    plain = assemble_bank(clips, p, false);
-    const bool keep = !with.empty() && (options.dictionary == BankDictionary::always || with.size() < plain.size());
-    out.bytes_without_dictionary = keep ? plain.size() : 0;
-    out.dictionary_bytes = keep ? d.dictionary.size() : 0;
-    out.bytes = keep ? std::move(with) : std::move(plain);
+    std::vector<uint8_t> best = assemble_bank(clips, p, false);
+    out.bytes_without_dictionary = best.size();
+    if (options.dictionary != BankDictionary::never) {
+      const Samples samples = samples_of(raw);
+      std::vector<uint8_t> with;
+      for (size_t share : {200, 50, 12}) {
+        Parts d = p;
+        d.dictionary = train_dictionary(samples, std::clamp<size_t>(samples.bytes.size() / share, 1024, 112640));
+        if (d.dictionary.empty()) continue;
+        d.members = archive_members(raw, d.dictionary);
+        std::vector<uint8_t> bank = assemble_bank(clips, d, false);
+        if (with.empty() || bank.size() < with.size()) with = std::move(bank), out.dictionary_bytes = d.dictionary.size();
+      }
+      if (!with.empty() && (options.dictionary == BankDictionary::always || with.size() < best.size())) best = std::move(with);
+      else out.dictionary_bytes = 0;
+    }
+    if (out.dictionary_bytes == 0) out.bytes_without_dictionary = 0;
+    out.bytes = std::move(best);
   }
   out.skeletons = static_cast<uint32_t>(p.skeletons.size());
   return out;

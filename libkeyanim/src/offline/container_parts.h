@@ -43,6 +43,8 @@ std::vector<RawSection> archive_raw_sections(const EncodedClip& clip, std::optio
 // Each section a zstd frame (made with `dictionary` when it is not empty: a bank's, spec
 // section 10.4) when that is smaller, else stored raw; one zstd context at a time.
 std::vector<Section> compress_sections(std::vector<RawSection> raw, std::span<const uint8_t> dictionary);
+// SKEL's content as write_kanim stores it: a zstd frame at its parameters when that is smaller.
+Section stored_skel(std::vector<uint8_t> skel);
 // The runtime profile's sections of `clip`: CLIP, IMAG, SKEL, NOTE if any (section 9.1).
 std::vector<Section> runtime_sections(const Clip& clip);
 uint32_t crc32_of(const uint8_t* p, size_t n);  // the archive profile's checksum (3.3)

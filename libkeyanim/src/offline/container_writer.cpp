@@ -342,6 +342,12 @@ std::vector<Section> compress_sections(std::vector<RawSection> raw, std::span<co
   return sections;
 }
 
+Section stored_skel(std::vector<uint8_t> skel) {
+  std::vector<RawSection> raw(1);
+  raw[0] = {internal::kTagSkel, 0, std::move(skel), kSkelZstd, {}};
+  return std::move(compress_sections(std::move(raw), {})[0]);
+}
+
 std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level) {
   const std::vector<Section> sections = compress_sections(archive_raw_sections(clip, zstd_level), {});
   std::vector<uint8_t> out = assemble(sections, kFormatVersionMajor, kFormatVersionMinor, 0, internal::kChecksumSize);

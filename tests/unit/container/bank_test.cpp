@@ -67,7 +67,7 @@ void put_le(std::vector<uint8_t>& b, uint64_t at, int n, uint64_t v) {
 struct Layout {
   uint64_t clips, skeletons, skeleton_table = 40, clip_table, name_order, names, checksum;
   explicit Layout(const std::vector<uint8_t>& b)
-      : clips(get_le(b, 16, 4)), skeletons(get_le(b, 20, 4)), clip_table(40 + 16 * skeletons),
+      : clips(get_le(b, 16, 4)), skeletons(get_le(b, 20, 4)), clip_table(40 + 32 * skeletons),
         name_order(clip_table + 40 * clips), names(name_order + 4 * clips),
         checksum(get_le(b, clip_table, 8) - 8) {}  // the first member follows the checksum
   uint64_t clip(uint64_t i) const { return clip_table + 40 * i; }
@@ -256,7 +256,19 @@ TEST_CASE("the rules of section 10, broken one at a time") {
     CHECK(broken([&](auto& b) { put_le(b, l.clip(3) + 8, 8, 1u << 30); }) == Status::truncated);
     CHECK(broken([&](auto& b) { put_le(b, l.clip(1), 8, get_le(b, l.clip(0), 8)); }) == Status::corrupt);
     CHECK(broken([&](auto& b) { put_le(b, l.clip(1), 8, get_le(b, l.clip(1), 8) + 8); }) == Status::corrupt);
-    CHECK(broken([&](auto& b) { put_le(b, l.clip(0) + 8, 8, get_le(b, l.clip(0) + 8, 8) - 1); }) != Status::ok);
+    {  // a member one byte short: the next still starts where 10.1 says; the byte cut off is now
+       // padding before clip 1, which is not zero: those two fail, the others load
+      std::vector<uint8_t> b = good;
+      put_le(b, l.clip(0) + 8, 8, get_le(b, l.clip(0) + 8, 8) - 1);
+      fix_checksum(b);
+      Bank bank;
+      Clip clip;
+      if (Bank::open(b, bank) == Status::ok) {
+        CHECK(bank.clip(0, clip) == Status::truncated);
+        CHECK(bank.clip(1, clip) == Status::corrupt);
+        CHECK(bank.clip(2, clip) == Status::ok);
+      }
+    }
     CHECK(broken([&](auto& b) { put_le(b, l.skeleton_table, 8, 0); }) == Status::corrupt);
   }
   SUBCASE("names: two clips of one name, '..', an empty part, a byte 0, the order") {

@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <new>
+#include <vector>
 
 #include "runtime/bank/bank_index.h"
 #include "runtime/load/member.h"
@@ -24,6 +25,7 @@ struct Bank::State {
   std::shared_ptr<const void> storage;  // owns the bytes (a copy or a mapping); null: the caller does
   internal::BankIndex index;
   std::unique_ptr<ZSTD_DDict, DDictDeleter> dictionary;
+  std::vector<std::vector<uint8_t>> skeletons;  // each one's content, inflated once at open
   mutable RigCache rigs;  // thread-safe
 };
 
@@ -61,6 +63,10 @@ Status Bank::make(std::span<const uint8_t> bytes, std::shared_ptr<const void> st
     state->dictionary.reset(ZSTD_createDDict(dict.data(), dict.size()));
     if (!state->dictionary) return out_of_memory(err);
   }
+  uint64_t limit = DecodeLimits{}.max_decompressed_bytes;  // what all skeletons may inflate to
+  state->skeletons.resize(state->index.skeletons);           // bounded: the table fits in the bank
+  for (uint32_t k = 0; k < state->index.skeletons; ++k)
+    if (Status s = internal::skeleton_content(state->index, k, limit, state->skeletons[k], err); s != Status::ok) return s;
   state->storage = std::move(storage);
   out.state_ = std::move(state);
   return Status::ok;
@@ -157,12 +163,16 @@ Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& lim
   const internal::BankIndex& idx = state_->index;
   const BankEntry e = idx.entry(i);
   internal::MemberContext m;
-  m.skel = idx.skeleton(e.skeleton, m.skel_offset);
+  m.skel = state_->skeletons[e.skeleton];
+  m.skel_offset = idx.skeleton(e.skeleton).offset;
+  m.skel_compressed = idx.skeleton(e.skeleton).compressed;
   m.member_offset = e.offset;
   m.dictionary = state_->dictionary.get();
   m.runtime = idx.runtime;
   // The clip keeps the bank's state (and so its bytes and dictionary) alive.
-  Status s = internal::load_member(idx.bytes.subspan(e.offset, e.size), m, state_->storage ? state_ : nullptr, limits,
+  Status s = internal::check_member_padding(idx, i, err);
+  if (s == Status::ok)
+    s = internal::load_member(idx.bytes.subspan(e.offset, e.size), m, state_->storage ? state_ : nullptr, limits,
                                    &state_->rigs, out, err);
   const double frame_time = out.frame_time();
   if (s == Status::ok &&

@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include <zstd.h>
+
 #include "internal/format.h"
 #include "internal/xxh64.h"
+#include "internal/zstd_bound.h"
 #include "keyanim/version.h"
 
 namespace keyanim::internal {
@@ -62,9 +65,10 @@ bool zero_padding(std::span<const uint8_t> bytes, uint64_t from, uint64_t to) no
 }
 
 // One part placed at the next multiple of 8 after `end` (updated to the part's end): its table
-// entry at `entry` holds Offset and Size.
+// entry at `entry` holds Offset and (stored) Size. The padding before a member is checked when
+// the member is read (check_member_padding), so that opening a bank reads no member's page.
 Status place(std::span<const uint8_t> bytes, const uint8_t* entry, uint64_t& end, const char* table, uint32_t i,
-             ErrorInfo* err) {
+             bool padding, ErrorInfo* err) {
   const uint64_t at = static_cast<uint64_t>(entry - bytes.data());
   const uint64_t offset = load_le<uint64_t>(entry), size = load_le<uint64_t>(entry + 8);
   const std::string what = std::string(table) + " entry " + std::to_string(i);
@@ -74,8 +78,28 @@ Status place(std::span<const uint8_t> bytes, const uint8_t* entry, uint64_t& end
                     " (each part starts at the next multiple of 8 after the one before)");
   if (offset > bytes.size() || size > bytes.size() - offset)
     return fail(err, Status::truncated, table, at + 8, what + ": the file ends before its " + std::to_string(size) + " bytes");
-  if (!zero_padding(bytes, end, offset)) return fail(err, Status::corrupt, "padding", end, what + ": padding before it is not zero");
+  if (padding && !zero_padding(bytes, end, offset))
+    return fail(err, Status::corrupt, "padding", end, what + ": padding before it is not zero");
   end = offset + size;
+  return Status::ok;
+}
+
+// Skeleton s's flags and sizes (10.3): a compressed one's Raw_Size within what its stored bytes
+// can make (section 8), an uncompressed one's equal to them.
+Status check_skeleton_entry(const BankIndex& idx, uint32_t s, ErrorInfo* err) {
+  const uint8_t* e = idx.bytes.data() + idx.layout.skeleton_table + uint64_t(s) * kBankSkeletonEntrySize;
+  const uint64_t at = static_cast<uint64_t>(e - idx.bytes.data());
+  const BankIndex::Skeleton k = idx.skeleton(s);
+  const std::string what = "skeleton " + std::to_string(s);
+  if ((load_le<uint32_t>(e + 24) & kSkeletonReservedMask) != 0 || load_le<uint32_t>(e + 28) != 0)
+    return fail(err, Status::reserved_bits_set, "skeleton table", at + 24, what + ": reserved Skeleton_Flags bits or Skeleton_Reserved set");
+  if (k.stored == 0 || k.raw == 0)
+    return fail(err, Status::corrupt, "skeleton table", at + 8, what + ": size 0 (a skeleton is a SKEL section's content)");
+  if (!k.compressed && k.raw != k.stored)
+    return fail(err, Status::corrupt, "skeleton table", at + 16, what + ": uncompressed, but Raw_Size != Stored_Size");
+  if (k.compressed && k.raw > kMaxZstdExpansion * k.stored)  // stored < 2^48: exact
+    return fail(err, Status::zstd_error, "skeleton table", at + 16,
+                what + ": Raw_Size " + std::to_string(k.raw) + " is more than its " + std::to_string(k.stored) + " stored bytes can make");
   return Status::ok;
 }
 
@@ -87,10 +111,8 @@ Status check_placement(const BankIndex& idx, ErrorInfo* err) {
   uint64_t end = idx.layout.dictionary_end;
   for (uint32_t s = 0; s < idx.skeletons; ++s) {
     const uint8_t* e = bytes.data() + idx.layout.skeleton_table + uint64_t(s) * kBankSkeletonEntrySize;
-    if (Status st = place(bytes, e, end, "skeleton table", s, err); st != Status::ok) return st;
-    if (load_le<uint64_t>(e + 8) == 0)
-      return fail(err, Status::corrupt, "skeleton table", static_cast<uint64_t>(e - bytes.data()) + 8,
-                  "skeleton " + std::to_string(s) + ": Size 0 (a skeleton is a SKEL section's content)");
+    if (Status st = place(bytes, e, end, "skeleton table", s, true, err); st != Status::ok) return st;
+    if (Status st = check_skeleton_entry(idx, s, err); st != Status::ok) return st;
   }
   const uint64_t checksum_at = next_part(end);
   if (checksum_at > bytes.size() || bytes.size() - checksum_at < kBankChecksumSize)
@@ -98,7 +120,7 @@ Status check_placement(const BankIndex& idx, ErrorInfo* err) {
   if (!zero_padding(bytes, end, checksum_at)) return fail(err, Status::corrupt, "padding", end, "the padding before the checksum is not zero");
   end = checksum_at + kBankChecksumSize;
   for (uint32_t i = 0; i < idx.clips; ++i)
-    if (Status st = place(bytes, idx.clip_at(i), end, "clip table", i, err); st != Status::ok) return st;
+    if (Status st = place(bytes, idx.clip_at(i), end, "clip table", i, false, err); st != Status::ok) return st;
   if (end != bytes.size())
     return fail(err, Status::trailing_bytes, "bank", end, std::to_string(bytes.size() - end) + " bytes after the last clip");
   if (xxh64_of(bytes.data(), checksum_at) != load_le<uint64_t>(bytes.data() + checksum_at))
@@ -154,6 +176,40 @@ Status check_names(const BankIndex& idx, ErrorInfo* err) {
 }
 
 }  // namespace
+
+Status check_member_padding(const BankIndex& idx, uint32_t i, ErrorInfo* err) {
+  const BankEntry e = idx.entry(i);
+  // The part before member 0 is the checksum: it ends at a multiple of 8, so member 0 has none.
+  const uint64_t end = i == 0 ? e.offset : idx.entry(i - 1).offset + idx.entry(i - 1).size;
+  if (!zero_padding(idx.bytes, end, e.offset))
+    return fail(err, Status::corrupt, "padding", end, "clip table entry " + std::to_string(i) + ": padding before it is not zero");
+  return Status::ok;
+}
+
+Status skeleton_content(const BankIndex& idx, uint32_t s, uint64_t& limit, std::vector<uint8_t>& out, ErrorInfo* err) {
+  const BankIndex::Skeleton k = idx.skeleton(s);
+  const uint8_t* src = idx.bytes.data() + k.offset;
+  const std::string what = "skeleton " + std::to_string(s);
+  if (k.raw > limit)
+    return fail(err, Status::limit_exceeded, "skeleton table", idx.layout.skeleton_table + uint64_t(s) * kBankSkeletonEntrySize + 16,
+                "the bank's skeletons exceed the limit of decompressed bytes");
+  limit -= k.raw;
+  if (!k.compressed) {
+    out.assign(src, src + k.stored);
+    return Status::ok;
+  }
+  // As a compressed section (3.2.5): one frame declaring Raw_Size, whose blocks can make it.
+  const size_t stored = static_cast<size_t>(k.stored);
+  const std::optional<uint64_t> bound = zstd_frame_output_bound(src, stored);
+  if (stored < 4 || load_le<uint32_t>(src) != kZstdMagic || ZSTD_getFrameContentSize(src, stored) != k.raw ||
+      ZSTD_findFrameCompressedSize(src, stored) != stored || !bound || *bound < k.raw)
+    return fail(err, Status::zstd_error, "skeleton", k.offset, what + ": not one zstd frame of Raw_Size bytes");
+  out.resize(static_cast<size_t>(k.raw));
+  const size_t got = ZSTD_decompress(out.data(), out.size(), src, stored);
+  if (ZSTD_isError(got) || got != k.raw)
+    return fail(err, Status::zstd_error, "skeleton", k.offset, what + ": zstd: " + (ZSTD_isError(got) ? ZSTD_getErrorName(got) : "wrong size"));
+  return Status::ok;
+}
 
 Status check_bank_index(std::span<const uint8_t> bytes, BankIndex& out, ErrorInfo* err) {
   if (err != nullptr) *err = ErrorInfo{};

@@ -51,6 +51,7 @@ struct DctxDeleter {
 struct MemberContext {
   std::span<const uint8_t> skel;
   uint64_t skel_offset = 0;
+  bool skel_compressed = false;  // stored as a zstd frame: offsets in it are of its content
   uint64_t member_offset = 0;
   const ZSTD_DDict* dictionary = nullptr;
   bool runtime = false;  // the bank's profile, which its members must have

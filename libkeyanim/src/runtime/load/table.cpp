@@ -252,7 +252,7 @@ Status Loader::get_skel(int index, Content& out) {
   out.data = member_->skel.data();
   out.size = member_->skel.size();
   out.file_offset = member_->skel_offset - member_->member_offset;  // wraps: fail() adds it back
-  out.compressed = false;
+  out.compressed = member_->skel_compressed;
   return Status::ok;
 }
 
