@@ -10,7 +10,10 @@
 #include <xxhash.h>
 
 #include <doctest/doctest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -188,6 +191,21 @@ TEST_CASE("runtime clips are sampled where they lie in a viewed bank") {
   CHECK(b.sample(10.5, x) == Status::ok);
   CHECK(a.sample(10.5, y) == Status::ok);
   CHECK(std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0);
+}
+
+TEST_CASE("open_file maps regular files only: a FIFO is refused without waiting for a writer") {
+  char dir[] = "/tmp/keyanim_bank_test.XXXXXX";
+  REQUIRE(::mkdtemp(dir) != nullptr);
+  const std::string fifo = std::string(dir) + "/pipe.kbank";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  Bank b;
+  ErrorInfo err;
+  CHECK(Bank::open_file(fifo, b, &err) == Status::io_error);  // a hang here: open() without O_NONBLOCK
+  CHECK(err.detail.find("not a regular file") != std::string::npos);
+  CHECK(Bank::open_file("/dev/zero", b, &err) == Status::io_error);
+  CHECK(b.clip_count() == 0);
+  ::unlink(fifo.c_str());
+  ::rmdir(dir);
 }
 
 TEST_CASE("a damaged clip fails by its name; the others still load") {

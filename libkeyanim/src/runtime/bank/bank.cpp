@@ -103,7 +103,9 @@ Status Bank::open_file(const std::string& path, Bank& out, ErrorInfo* err) {
     if (err != nullptr) *err = ErrorInfo{Status::io_error, 0, "file", path + ": " + what + ": " + std::strerror(errno)};
     return Status::io_error;
   };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a FIFO's open would wait for a writer; it is then refused as not a regular
+  // file (the flag changes nothing for a regular file, which is mapped, not read).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return io_fail("cannot open");
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
