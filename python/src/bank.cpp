@@ -266,8 +266,8 @@ void register_bank(py::module_& m) {
         "encode's. The file is written to a temporary file beside `path` and renamed once complete;\n"
         "an existing file is replaced only with overwrite=True (else FileExistsError). Returns a\n"
         "dict: file, clips, skeletons, bytes, profile, dictionary_bytes (0: none) and\n"
-        "bytes_without_dictionary (with dictionary='auto' and a dictionary kept, the size the bank\n"
-        "would have without it; else None).");
+        "bytes_without_dictionary (when a dictionary is kept, the size the bank would have\n"
+        "without it; else None).");
 }
 
 }  // namespace keyanim::python

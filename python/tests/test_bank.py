@@ -66,7 +66,7 @@ def read_index(path):
     b = path.read_bytes()
     assert b[:4] == SIGNATURE
     major, minor, flags, clips, skeletons, names_size, dictionary = struct.unpack_from("<HHIIIQQ", b, 8)
-    table = 40 + 16 * skeletons
+    table = 40 + 32 * skeletons
     entries = []
     for i in range(clips):
         offset, size, frame_time, frames, skeleton, name_offset, name_size = struct.unpack_from("<QQdIIII", b, table + 40 * i)
@@ -181,7 +181,7 @@ def test_a_damaged_clip_is_named_and_the_others_load(library, tmp_path):
     # The index itself is covered by the bank's checksum: a changed frame count is refused at open.
     data = bytearray(library["archive"].read_bytes())
     skeletons = struct.unpack_from("<I", data, 20)[0]
-    data[40 + 16 * skeletons + 24] ^= 1
+    data[40 + 32 * skeletons + 24] ^= 1
     with pytest.raises(keyanim.Error, match="checksum_mismatch"):
         keyanim.Bank(bytes(data))
 
@@ -257,7 +257,7 @@ def test_the_dictionary_settings(library, tmp_path):
     always = keyanim.write_bank(tmp_path / "always.kbank", clips, dictionary="always")
     assert never["dictionary_bytes"] == 0 and never["bytes_without_dictionary"] is None
     assert keyanim.Bank(tmp_path / "always.kbank").dictionary_bytes == always["dictionary_bytes"]
-    assert always["bytes_without_dictionary"] is None  # not made: the dictionary is kept anyway
+    assert always["bytes_without_dictionary"] == never["bytes"]  # what the same bank is without it
     assert always["dictionary_bytes"] > 0  # zstd trained one on these sections
     # 'auto' keeps the smaller of the two, and then says what the other would have been.
     auto = library["report"]
