@@ -7,13 +7,16 @@
 #   stdout      two things on standard output, two inputs on standard input
 #   limits      work and memory in proportion: decode caps and streaming, deep skeletons,
 #               endless or oversized inputs
+#   gltf_depth  glTF export of the deepest chain a BVH may hold: work linear in the depth
+#   gltf_rounds glTF export of a deep chain whose fit takes many rounds: the same
 #   tolerance   no tolerance claimed where none was applied
 #   preflight   outputs checked before the work
 #   exit_table  the exit code table of --help and the README, one command per row
 # "asan": the binary is built with AddressSanitizer, so address-space limits (ulimit -v) are
 # left out.
 set -uo pipefail
-README=$(realpath "$(dirname "${BASH_SOURCE[0]}")/../../README.md")
+HERE=$(realpath "$(dirname "${BASH_SOURCE[0]}")")
+README=$HERE/../../README.md
 . "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
 ASAN=${4:-}
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
@@ -40,18 +43,29 @@ no_temps() {
 named_bvh() {  # named_bvh FILE NAME_FORMAT
   printf "HIERARCHY\nROOT $2\n{\n OFFSET 5 0 0\n CHANNELS 1 Xposition\n End Site\n {\n  OFFSET 1 0 0\n }\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n1\n2\n4\n" >"$1"
 }
-# A chain of N joints (one Zrotation each) and 3 frames.
-chain_bvh() {  # chain_bvh FILE N
-  "$PY" - "$1" "$2" <<'EOF'
-import sys
+# A chain of N joints (one Zrotation each): 3 frames of turns by whole degrees, or with "wave F",
+# F frames of small turns in phase along the chain (their errors add up at the tip).
+chain_bvh() {  # chain_bvh FILE N [wave F]
+  "$PY" - "$@" <<'EOF'
+import math, sys
 path, n = sys.argv[1], int(sys.argv[2])
+wave = sys.argv[3:4] == ["wave"]
+frames = int(sys.argv[4]) if wave else 3
 out = ["HIERARCHY"]
 for i in range(n):
     out += [("ROOT" if i == 0 else "JOINT") + " j%d" % i, "{", "OFFSET 0 1 0", "CHANNELS 1 Zrotation"]
-out += ["End Site", "{", "OFFSET 0 1 0", "}"] + ["}"] * n + ["MOTION", "Frames: 3", "Frame Time: 0.1"]
-out += [" ".join(str((f * (i % 7)) % 5) for i in range(n)) for f in range(3)]
+out += ["End Site", "{", "OFFSET 0 1 0", "}"] + ["}"] * n + ["MOTION", "Frames: %d" % frames, "Frame Time: 0.1"]
+turn = (lambda f, i: "%.6f" % (0.01 * math.sin(0.3 * f + 0.01 * i))) if wave else (lambda f, i: str((f * (i % 7)) % 5))
+out += [" ".join(turn(f, i) for i in range(n)) for f in range(frames)]
 open(path, "w").write("\n".join(out) + "\n")
 EOF
+}
+# Exports the chain BVH to glTF and checks the GLB against the clip (check_chain_glb.py).
+export_chain() {  # export_chain NAME
+  expect_rc 0 "$K" encode "$1.bvh" -o "$1.kanim"
+  expect_rc 0 "$K" decode "$1.kanim" -o "$1.glb"
+  expect_rc 0 "$K" decode "$1.kanim" -o "$1.clip.bvh"
+  "$PY" "$HERE/check_chain_glb.py" "$1.glb" "$1.clip.bvh" || die "the glTF export of $1.bvh fails its check"
 }
 
 case "$CASE" in
@@ -246,6 +260,20 @@ limits)
   [ ! -e z.kanim ] && [ ! -e z.bvh ] && [ ! -e z.svg ] || die "a refused input left an output"
   # Threads: a huge -j is clamped to the cores, not obeyed.
   expect_rc 0 "$K" encode "$WALK" -o j.kanim -j 4294967295
+  ;;
+gltf_depth)
+  # 65,535 joints and an End Site (the most nodes a BVH may have), fitted in one round. With the
+  # fit's budgets walking every ancestor of every point, the export took 183 s of CPU here; it
+  # takes 1 s, and the case 8 s in all (tests/cli/CMakeLists.txt gives it 90 s).
+  chain_bvh deep.bvh 65535
+  export_chain deep
+  ;;
+gltf_rounds)
+  # 8,000 joints over 10 frames, whose errors add up along the chain: 20 rounds of fitting, each
+  # blaming the tracks that move every stray point. Walking each one's ancestors, the export
+  # took 158 s of CPU here; it takes 2.3 s, and the case 4 s in all (its timeout is 90 s too).
+  chain_bvh wave.bvh 8000 wave 10
+  export_chain wave
   ;;
 tolerance)
   # Modes that do not apply the tolerance never print one, and warn when a given --error is

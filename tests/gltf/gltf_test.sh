@@ -5,6 +5,9 @@
 #   gltf_test.sh KEYANIM CORPUS_DIR corpus FILE_GLOB...  every matching file of the folder: encode at
 #                                                0.05%, export with the defaults and with
 #                                                --linear, check both
+#   gltf_test.sh KEYANIM DATA_DIR deep           a chain deeper than the fit walks a point's
+#                                                movers at once (gltf_fit.cpp's kWindow), exported
+#                                                and checked as the corpus is
 # Needs node, and three and gltf-validator installed beside copies of the .mjs scripts in
 # $KEYANIM_GLTF_NODE_DIR (the build tree's tests/gltf, where the build runs npm ci; default: this
 # folder, after `npm ci` here). Exits 77 (skipped) when the corpus is absent.
@@ -107,6 +110,30 @@ corpus)
   node "$CHECK" --percent 0.05 "${triples[@]}" || die "exports fail their checks"
   node "$CHECK" --percent 0.05 --linear "${linear[@]}" || die "--linear exports fail their checks"
   echo "$(( ${#triples[@]} / 3 )) files: both exports validated and played within tolerance"
+  ;;
+deep)
+  # 300 joints one below the other, each turning a little about all three axes with its own
+  # phase: every point's movers are walked in several windows, and the errors of the joints
+  # above add up at the tip, so the fit takes many rounds.
+  /usr/bin/python3 - chain.bvh 300 30 <<'EOF' || die "writing the chain BVH"
+import math, sys
+path, n, frames = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+out = ["HIERARCHY"]
+for i in range(n):
+    out += [("ROOT" if i == 0 else "JOINT") + " j%d" % i, "{", "OFFSET 0 1 0", "CHANNELS 3 Zrotation Xrotation Yrotation"]
+out += ["End Site", "{", "OFFSET 0 1 0", "}"] + ["}"] * n + ["MOTION", "Frames: %d" % frames, "Frame Time: 0.0333333"]
+for f in range(frames):
+    out.append(" ".join("%.6f %.6f %.6f" % (0.1 * math.sin(0.3 * f + 0.01 * i), 0.05 * math.cos(0.2 * f + 0.03 * i),
+                                            0.02 * math.sin(0.1 * f - 0.02 * i)) for i in range(n)))
+open(path, "w").write("\n".join(out) + "\n")
+EOF
+  expect_rc 0 "$K" encode chain.bvh -o chain.kanim --error 0.05%
+  expect_rc 0 "$K" decode chain.kanim -o chain.clip.bvh
+  expect_rc 0 "$K" decode chain.kanim -o chain.glb
+  expect_rc 0 "$K" decode chain.kanim -o chain.linear.glb --linear
+  node "$CHECK" --percent 0.05 chain.bvh chain.clip.bvh chain.glb || die "the chain's export fails its checks"
+  node "$CHECK" --percent 0.05 --linear chain.bvh chain.clip.bvh chain.linear.glb || die "the chain's --linear export fails its checks"
+  echo "a 300-deep chain: both exports validated and played within tolerance"
   ;;
 *) die "unknown case $CASE" ;;
 esac

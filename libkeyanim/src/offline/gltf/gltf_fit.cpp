@@ -17,6 +17,7 @@ constexpr uint32_t kMaxRounds = 24;
 constexpr double kTighten = 0.8;     // a blamed track's budget shrinks by this per round
 constexpr double kBlameShare = 0.6;  // tracks moving a stray point by at least this share of the
                                      // largest contribution are blamed
+constexpr uint32_t kWindow = 32;     // nodes a point's movers are walked up at once (walk_movers)
 
 // One node's rotation (k = 4) or translation (k = 3) at every frame of the window.
 struct Target {
@@ -168,15 +169,33 @@ Sampler fit(Target& t, const Window& w, bool linear_only) {
 
 double distance(const Vec3& a, const Vec3& b) { return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]); }
 
-// The rotating ancestors of a point (its owner too for shell points), and the translated ones
-// (the owner and every ancestor), calling f(node, rotation).
-template <typename F>
-void movers(const Skeleton& sk, const Reference& ref, uint32_t p, F f) {
-  const uint32_t o = ref.owner(p);
-  for (int32_t a = int32_t(o); a >= 0; a = sk.joints[size_t(a)].parent) {
-    if (a != int32_t(o) || ref.moved_by_owner(p)) f(uint32_t(a), true);
-    f(uint32_t(a), false);
-  }
+// Calls visit(node, rotation, lever) for each track moving each of the points at frame index i:
+// its rotating ancestors (its owner too for shell points), with the distance from the node to
+// the point as the lever arm, and its translated ones (the owner and every ancestor); then
+// walked() after each point. Walking every ancestor of every point is quadratic in the depth (a
+// chain of 16,000 joints: 10 s), so a walk stops kWindow nodes up and hands the point on to
+// the joint at its top, which stands for it with their distance added to its lever arms (a
+// bound, by the triangle inequality) and is walked in turn, once for everything handed on to it
+// at that frame. Skeletons up to kWindow deep get every lever arm exactly, as if walked to the root.
+template <typename Visit, typename Walked>
+void walk_movers(const Skeleton& sk, const Reference& ref, uint32_t i, const std::vector<uint32_t>& points,
+                 Visit visit, Walked walked) {
+  std::vector<double> handed(sk.joints.size(), -1.0);  // per joint: the farthest point handed on (-1: none)
+  const auto walk = [&](uint32_t start, bool own_rotation, const Vec3& at, double radius) {
+    for (uint32_t a = start, n = 1;; a = uint32_t(sk.joints[a].parent), ++n) {
+      if (a != start || own_rotation) visit(a, true, distance(at, ref.point(i, a)) + radius);
+      visit(a, false, 0.0);
+      if (sk.joints[a].parent < 0) break;
+      if (n == kWindow) {
+        handed[a] = std::max(handed[a], distance(at, ref.point(i, a)) + radius);
+        break;
+      }
+    }
+    walked();
+  };
+  for (uint32_t p : points) walk(ref.owner(p), ref.moved_by_owner(p), ref.point(i, p), 0.0);
+  for (uint32_t w = uint32_t(handed.size()); w-- > 0;)  // parents first: a joint's walk hands on to an earlier one
+    if (handed[w] >= 0.0) walk(uint32_t(sk.joints[w].parent), true, ref.point(i, w), handed[w]);
 }
 
 // Initial budgets, as if each track were the only source of error: a rotation moves the
@@ -184,12 +203,16 @@ void movers(const Skeleton& sk, const Reference& ref, uint32_t p, F f) {
 // its points by the tolerance.
 void initial_budgets(std::vector<Target>& targets, const Skeleton& sk, const Reference& ref, double tolerance) {
   std::vector<double> reach(sk.joints.size(), 0.0);
+  std::vector<uint32_t> measured;
+  for (uint32_t p = 0; p < ref.point_count(); ++p)
+    if (ref.measured(p)) measured.push_back(p);
   for (uint32_t i = 0; i < ref.window().frames(); ++i)
-    for (uint32_t p = 0; p < ref.point_count(); ++p)
-      if (ref.measured(p))
-        movers(sk, ref, p, [&](uint32_t a, bool rotation) {
-          if (rotation) reach[a] = std::max(reach[a], distance(ref.point(i, p), ref.point(i, a)));
-        });
+    walk_movers(
+        sk, ref, i, measured,
+        [&](uint32_t a, bool rotation, double lever) {
+          if (rotation) reach[a] = std::max(reach[a], lever);
+        },
+        [] {});
   for (Target& t : targets)
     t.budget = !t.rotation() ? tolerance : reach[t.node] > 0.0 ? tolerance / reach[t.node] : 1.0;
 }
@@ -200,19 +223,27 @@ std::vector<bool> blame(const std::vector<Violation>& violations, const std::vec
                         const std::vector<int32_t> (&target_of)[2], const Skeleton& sk, const Reference& ref) {
   std::vector<bool> marked(targets.size(), false);
   std::vector<std::pair<int32_t, double>> chain;
-  for (const Violation& v : violations) {
-    chain.clear();
-    double largest = 0.0;
-    movers(sk, ref, v.point, [&](uint32_t a, bool rotation) {
+  double largest = 0.0;
+  std::vector<uint32_t> points;
+  for (size_t v = 0; v < violations.size();) {  // check_model lists them frame by frame
+    const uint32_t i = violations[v].frame_index;
+    points.clear();
+    for (; v < violations.size() && violations[v].frame_index == i; ++v) points.push_back(violations[v].point);
+    const auto visit = [&](uint32_t a, bool rotation, double lever) {
       const int32_t ti = target_of[rotation][a];
       if (ti < 0) return;
-      double c = targets[size_t(ti)].local_error[v.frame_index];
-      if (rotation) c *= distance(ref.point(v.frame_index, v.point), ref.point(v.frame_index, a));
+      double c = targets[size_t(ti)].local_error[i];
+      if (rotation) c *= lever;
       chain.push_back({ti, c});
       largest = std::max(largest, c);
-    });
-    for (const auto& [ti, c] : chain)
-      if (largest > 0.0 && c >= kBlameShare * largest) marked[size_t(ti)] = true;
+    };
+    const auto walked = [&] {
+      for (const auto& [ti, c] : chain)
+        if (largest > 0.0 && c >= kBlameShare * largest) marked[size_t(ti)] = true;
+      chain.clear();
+      largest = 0.0;
+    };
+    walk_movers(sk, ref, i, points, visit, walked);
   }
   return marked;
 }
@@ -249,23 +280,35 @@ uint32_t fit_keys(Model& model, const std::vector<NodeCurves>& nodes, const std:
     }
   }
   initial_budgets(targets, sk, reference, tolerance);
-  std::vector<bool> refit(targets.size(), true);
+  std::vector<bool> refit(targets.size(), true), marked;
   const auto report = [&](EncodeStage stage, double f) {
     if (progress) progress(stage, f);
   };
+  CheckResult r;
   for (uint32_t rounds = 1;; ++rounds) {
     const size_t todo = size_t(std::count(refit.begin(), refit.end(), true));
     size_t done = 0;
+    bool changed = rounds == 1;
     for (size_t i = 0; i < targets.size(); ++i) {
       if (!refit[i]) continue;
       NodeAnimation& anim = model.nodes[targets[i].node];
-      (targets[i].rotation() ? anim.rotation : anim.translation) = fit(targets[i], w, linear_only);
+      std::optional<Sampler>& track = targets[i].rotation() ? anim.rotation : anim.translation;
+      Sampler s = fit(targets[i], w, linear_only);
+      changed = changed || track != s;
+      track = std::move(s);
       report(EncodeStage::fitting, double(++done) / double(todo));
     }
     report(EncodeStage::fitting, 1.0);
-    const CheckResult r = check_model(model, reference, tolerance, [&](double f) { report(EncodeStage::verifying, f); });
-    if (r.violations.empty()) return rounds;
-    refit = blame(r.violations, targets, target_of, sk, reference);
+    // A tighter budget often gives the same keys (a budget well above what the keys reach):
+    // then the model, its check and the blame are the last round's, and only the budgets shrink.
+    if (changed) {
+      r = check_model(model, reference, tolerance, [&](double f) { report(EncodeStage::verifying, f); });
+      if (r.violations.empty()) return rounds;
+      marked = blame(r.violations, targets, target_of, sk, reference);
+    } else {
+      report(EncodeStage::verifying, 1.0);
+    }
+    refit = marked;
     bool any = false;
     for (size_t i = 0; i < targets.size(); ++i) {
       if (!refit[i] || targets[i].every_frame) {

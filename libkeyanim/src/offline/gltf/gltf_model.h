@@ -28,6 +28,7 @@ struct Sampler {
   std::vector<float> values;  // linear: times.size() * components; cubic: 3 times that, per key
                               // in-tangent, value, out-tangent (tangents per second)
   size_t key_count() const noexcept { return times.size(); }
+  bool operator==(const Sampler&) const = default;
 };
 
 struct NodeAnimation {
