@@ -3,6 +3,8 @@
 
 usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
        fuzz/make_seeds.py --view KEYANIM_BINARY   (view/ alone, from the committed load/ seeds)
+       fuzz/make_seeds.py --bank MAKE_BANK_SEEDS  (bank/ alone: build/fuzz/make_bank_seeds, built by
+                                                   cmake --build build --target make_bank_seeds)
 
  - bvh/:       tests/data/bvh fixtures, data/*.bvh and CMU clips of the shared corpus cut to 3 frames
  - roundtrip/: a settings byte + BVH snippets of at most 2000 values (see fuzz_roundtrip.cpp)
@@ -12,6 +14,8 @@ usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
  - view/:      view_seeds(): spec/test-vectors/v4_*.kanim (the runtime profile) and the runtime
                profile (keyanim convert --runtime) of load/'s CMU seeds, those encoded at the
                default error and at 1% with uniform:5 keys (the _raw ones are the same clips)
+ - bank/:      bank_seeds(): banks written by write_bank (make_bank_seeds.cpp says which); not
+               part of a plain run, since the helper is a C++ program of the build, not the CLI
  - c_api/:     c_api_seeds(): a few of sample/'s seeds with every fuzz_c_api request kind, loaded
                with the CRC-32 as given (byte 0 >= 231): intact, a byte flipped, cut short
 
@@ -153,6 +157,14 @@ def view_seeds(keyanim, corpus):
                            check=True)
 
 
+def bank_seeds(helper, corpus):
+    """fuzz_bank's seeds: make_bank_seeds writes them (the library's write_bank; the CLI has no
+    bank command) and checks that each is under 64 KiB."""
+    out = os.path.join(corpus, "bank")
+    os.makedirs(out, exist_ok=True)
+    subprocess.run([helper, ROOT, out], check=True)
+
+
 def c_api_seeds(corpus):
     """fuzz_c_api's own seeds, made from sample/'s: 24 requests (byte 0 = 255: 255 % 33 = 24,
     and >= 231, so that the CRC-32 is kept) of every kind (channels, local, model; by frame or
@@ -174,5 +186,7 @@ def c_api_seeds(corpus):
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--view":
         view_seeds(sys.argv[2], os.path.join(HERE, "corpus"))
+    elif len(sys.argv) == 3 and sys.argv[1] == "--bank":
+        bank_seeds(sys.argv[2], os.path.join(HERE, "corpus"))
     else:
         main()

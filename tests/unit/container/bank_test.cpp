@@ -317,6 +317,26 @@ TEST_CASE("the rules of section 10, broken one at a time") {
   }
 }
 
+TEST_CASE("a dictionary whose entropy tables do not decode is corrupt (fuzz_bank)") {
+  // zstd refuses such a dictionary as it would refuse memory; the bank said "out of memory"
+  // (limit_exceeded) for it (corpus/bank/crash-dictionary-tables.kbank).
+  off::BankOptions o;
+  o.dictionary = off::BankDictionary::always;
+  std::vector<uint8_t> b = off::write_bank(inputs(), o).bytes;
+  const Layout l(b);
+  const uint64_t dict = (l.names + get_le(b, 24, 8) + 7) / 8 * 8, dict_size = get_le(b, 32, 8);
+  REQUIRE(dict_size > 8 + 65);
+  REQUIRE(get_le(b, dict, 4) == 0xEC30A437u);
+  // After the magic and the dictionary ID, the literals' Huffman table: a header byte of 255
+  // says 128 weights in 4 bits each, and weights of 15 exceed any table zstd decodes.
+  for (uint64_t i = dict + 8; i < dict + 8 + 65; ++i) b[i] = 0xFF;
+  fix_checksum(b);
+  ErrorInfo err;
+  CHECK(open_fails(b, &err) == Status::corrupt);
+  CHECK(err.section == "dictionary");
+  CHECK(err.byte_offset == dict);
+}
+
 TEST_CASE("a member's own rules (10.5)") {
   off::BankOptions o;
   o.dictionary = off::BankDictionary::never;

@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zstd.h>
+#include <zstd_errors.h>
 
 #include <cstring>
 #include <new>
@@ -43,6 +44,23 @@ Status out_of_memory(ErrorInfo* err) {
   return Status::limit_exceeded;
 }
 
+// ZSTD_createDDict refused the dictionary: its entropy tables do not decode (the dictionary is
+// not what section 10.4 says: corrupt) or memory ran out. zstd's stable API tells which only by
+// decompressing with the dictionary: an empty frame (magic, a header without a content size,
+// one empty last Raw block), which loads the tables as the DDict did.
+Status dictionary_refused(std::span<const uint8_t> dict, uint64_t offset, ErrorInfo* err) {
+  static constexpr uint8_t kEmptyFrame[] = {0x28, 0xB5, 0x2F, 0xFD, 0x00, 0x00, 0x01, 0x00, 0x00};
+  ZSTD_DCtx* dctx = ZSTD_createDCtx();
+  if (dctx == nullptr) return out_of_memory(err);
+  const size_t r = ZSTD_decompress_usingDict(dctx, nullptr, 0, kEmptyFrame, sizeof kEmptyFrame, dict.data(), dict.size());
+  ZSTD_freeDCtx(dctx);
+  if (!ZSTD_isError(r) || ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation) return out_of_memory(err);
+  if (err != nullptr)
+    *err = ErrorInfo{Status::corrupt, offset, "dictionary",
+                     std::string("not a zstd dictionary (RFC 8878 section 5): ") + ZSTD_getErrorName(r)};
+  return Status::corrupt;
+}
+
 // A read-only mapping of a whole file, unmapped with its last user.
 struct Mapping {
   void* at = nullptr;
@@ -61,7 +79,7 @@ Status Bank::make(std::span<const uint8_t> bytes, std::shared_ptr<const void> st
   if (!dict.empty()) {
     // Digested once for all the bank's clips (zstd's stable API copies it).
     state->dictionary.reset(ZSTD_createDDict(dict.data(), dict.size()));
-    if (!state->dictionary) return out_of_memory(err);
+    if (!state->dictionary) return dictionary_refused(dict, state->index.layout.dictionary, err);
   }
   uint64_t limit = DecodeLimits{}.max_decompressed_bytes;  // what all skeletons may inflate to
   state->skeletons.resize(state->index.skeletons);           // bounded: the table fits in the bank
