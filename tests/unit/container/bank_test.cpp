@@ -15,6 +15,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -363,6 +365,39 @@ TEST_CASE("a member's own rules (10.5)") {
   fix_checksum(b);
   REQUIRE(Bank::open(b, bank) == Status::ok);
   CHECK(bank.clip(1, clip) == Status::corrupt);
+}
+
+}  // TEST_SUITE
+
+TEST_SUITE("bank") {
+
+// spec/test-vectors/b41_*.kbank (Appendix C): each clip decodes as the vector it is named after,
+// bit for bit; in b41_damaged, clip v3_uniform fails its checksum and the others decode.
+TEST_CASE("the bank vectors decode as the vectors their clips are named after") {
+  for (const char* v : {"b41_archive", "b41_dictionary", "b41_runtime", "b41_damaged"}) {
+    CAPTURE(v);
+    std::ifstream in(std::string(KEYANIM_SPEC_DIR "/test-vectors/") + v + ".kbank", std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Bank bank;
+    REQUIRE(Bank::open(bytes, bank) == Status::ok);
+    CHECK(bank.clip_count() == (std::string(v) == "b41_runtime" ? 6u : 7u));
+    CHECK(bank.runtime_profile() == (std::string(v) == "b41_runtime"));
+    CHECK((bank.dictionary_bytes() > 0) == (std::string(v) == "b41_dictionary"));
+    for (uint32_t i = 0; i < bank.clip_count(); ++i) {
+      const std::string name(bank.entry(i).name);
+      CAPTURE(name);
+      Clip clip, own;
+      if (std::string(v) == "b41_damaged" && name == "v3_uniform") {
+        CHECK(bank.clip(i, clip) == Status::checksum_mismatch);
+        continue;
+      }
+      REQUIRE(bank.clip(i, clip) == Status::ok);
+      std::ifstream f(std::string(KEYANIM_SPEC_DIR "/test-vectors/") + name + ".kanim", std::ios::binary);
+      const std::vector<uint8_t> file((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+      REQUIRE(Clip::load(file, own) == Status::ok);
+      CHECK(same_values(clip, own));
+    }
+  }
 }
 
 }  // TEST_SUITE
