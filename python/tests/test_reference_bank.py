@@ -601,6 +601,17 @@ def member_without_member_bit(c):
     return with_checksum(bytes(b[:-4]), False)
 
 
+def member_header(major=None, flags_or=0):
+    """A member with Major_Version or Header_Flags changed, its CRC-32 recomputed."""
+    def make(c):
+        b = bytearray(c["member"])
+        if major is not None:
+            struct.pack_into("<H", b, 8, major)
+        struct.pack_into("<I", b, 12, struct.unpack_from("<I", b, 12)[0] | flags_or)
+        return with_checksum(bytes(b[:-4]), False)
+    return make
+
+
 def runtime_member_in_archive_bank(c):
     return as_member(vector("v4_uniform.kanim"))[0]
 
@@ -609,6 +620,8 @@ MEMBER_RULES = {
     # (clip index, how, status, message)
     "Member clear": (1, member_change(1, member_without_member_bit), "corrupt", "without the Member bit"),
     "Runtime unlike the bank's": (1, member_change(1, runtime_member_in_archive_bank), "corrupt", "Runtime differs"),
+    "Bank set in a member": (1, member_change(1, member_header(flags_or=BANK)), "corrupt", "Header_Flags has Bank set"),
+    "a member of version 3": (1, member_change(1, member_header(major=3)), "reserved_bits_set", "Header_Flags"),
     "a SKEL in the member": (1, member_change(1, remember("v3_uniform.kanim", keep_skel=True)), "corrupt",
                              "a SKEL section in a bank's member"),
     "a damaged member": (3, member_change(3, member_bytes(lambda b: b.__setitem__(-6, b[-6] ^ 4))),
@@ -664,10 +677,18 @@ def test_a_member_decoded_with_another_dictionary(dictionary_bank):
     check_member_refused(w2, w2.build(), 0, "zstd_error", "Dictionary mismatch", others_decode=False)
 
 
-def test_a_runtime_member_without_its_skel_and_with_skel():
+def test_a_runtime_member_with_a_skel_is_refused():
     w = make_bank(RUNTIME_CLIPS, runtime=True)
     w.clips[0]["member"] = as_member(vector("v4_rules.kanim"), keep_skel=True)[0]
     check_member_refused(w, w.build(), 0, "corrupt", "a SKEL section in a bank's member")
+
+
+def test_a_damaged_runtime_member_is_refused_by_its_xxh64():
+    w = make_bank(RUNTIME_CLIPS, runtime=True)
+    b = bytearray(w.clips[3]["member"])
+    b[200] ^= 1  # inside IMAG
+    w.clips[3]["member"] = bytes(b)
+    check_member_refused(w, w.build(), 3, "checksum_mismatch", "XXH64")
 
 
 if __name__ == "__main__":
