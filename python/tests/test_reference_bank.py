@@ -394,6 +394,18 @@ def test_the_command_line_lists_a_bank_and_prints_a_clip(archive, tmp_path):
     assert r.returncode == 1 and "no clip named 'long'" in r.stderr
 
 
+def test_the_command_line_reads_bank_colon_name_as_a_kanim(archive, tmp_path):
+    """LIB.kbank:NAME (keyanim's form) prints the values at positions, as FILE.kanim does."""
+    w, data = archive
+    path = tmp_path / "a:b.kbank"  # a ':' in the bank's own path too
+    path.write_bytes(data)
+    r, want = run(f"{path}:walk/rules", 0, 2.5, 19), run(VECTORS / "v3_rules.kanim", 0, 2.5, 19)
+    assert r.returncode == 0 and want.returncode == 0, r.stderr
+    assert r.stdout == want.stdout and len(r.stdout.splitlines()) == 3
+    r = run(f"{path}:walk")
+    assert r.returncode == 1 and "no clip named 'walk'" in r.stderr
+
+
 def test_the_command_line_names_a_damaged_clip(archive, tmp_path):
     w, data = archive
     b = bytearray(data)

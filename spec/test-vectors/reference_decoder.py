@@ -20,6 +20,8 @@ Usage:
   reference_decoder.py BANK                        print the bank's clip index as JSON
   reference_decoder.py BANK NAME                   print clip NAME's expected values as JSON, as
                                                    the .json beside a .kanim vector holds them
+  reference_decoder.py BANK:NAME [POSITION ...]    clip NAME of the bank as FILE.kanim above (the
+                                                   form keyanim's commands read)
 Exit status: 0, 1 for a file refused (the status and place on stderr) or no clip of that name,
 2 for a usage error.
 
@@ -1213,22 +1215,48 @@ def bank_main(path, data, names):
     return 0
 
 
+def split_bank_clip(arg):
+    """BANK:NAME -> (BANK, NAME) when arg is no file but its part before a ':' is (a name may
+    hold ':' too: the first such part that is a file); else (arg, None)."""
+    if os.path.exists(arg):
+        return arg, None
+    at = arg.find(":")
+    while at >= 0:
+        if os.path.isfile(arg[:at]):
+            return arg[:at], arg[at + 1:]
+        at = arg.find(":", at + 1)
+    return arg, None
+
+
+def read_clip(path, name):
+    """The clip of FILE.kanim (name None), or clip `name` of bank `path`."""
+    data = open(path, "rb").read()
+    if name is None:
+        return parse(data)
+    bank = open_bank(data)
+    i = find_clip(bank, os.fsencode(name))
+    if i is None:
+        raise KanimError("not_found", f"no clip named {name!r}")
+    return decode_member(bank, i)
+
+
 def main(argv):
     if len(argv) == 3 and argv[1] == "--write-json":
         for p in sorted(glob.glob(os.path.join(argv[2], "*.kanim"))):
             print(write_json(p))
         return 0
     if len(argv) >= 2 and not argv[1].startswith("--"):
+        path, name = split_bank_clip(argv[1])
         try:
-            data = open(argv[1], "rb").read()
-            if is_bank(data):
+            data = open(path, "rb").read() if name is None else None
+            if data is not None and is_bank(data):
                 if len(argv) > 3:
                     print(__doc__, file=sys.stderr)
                     return 2
-                return bank_main(argv[1], data, argv[2:])
-            clip = parse(data)
+                return bank_main(path, data, argv[2:])
+            clip = read_clip(path, name)
         except KanimError as e:
-            print(f"{argv[1]}: {e}", file=sys.stderr)
+            print(f"{path}: {e}", file=sys.stderr)
             return 1
         for x in [float(a) for a in argv[2:]] or [0.0]:
             print(x, [channel_value(clip, c, x) for c in range(len(clip["frames"]))])
