@@ -10,6 +10,8 @@ choose, and sample clips at any time, with numpy arrays::
     pose = clip.sample([0.0, 0.5, 1.25])              # float32 (3, channels)
     rotations, translations = clip.local_transforms([0.5])
     dataset = keyanim.Dataset("clips/", fps=30, window=64)
+    keyanim.write_bank("walks.kbank", {"walk": clip})  # many clips in one file
+    bank = keyanim.Bank("walks.kbank")                  # bank.names, bank.clip("walk")
 
 Nodes are the joints and End Sites of the file, in file order; angles are degrees and lengths
 the file's units. Failures raise keyanim.Error (a ValueError carrying file:line:column for BVH,
@@ -17,6 +19,7 @@ section and byte offset for .kanim) or OSError for files that cannot be read or 
 """
 
 from ._keyanim import (
+    Bank,
     Clip,
     Error,
     Motion,
@@ -26,10 +29,12 @@ from ._keyanim import (
     format_version,
     measure_error,
     read_bvh,
+    write_bank,
 )
 from .dataset import Dataset
 
 __all__ = [
+    "Bank",
     "Clip",
     "Dataset",
     "Error",
@@ -39,4 +44,5 @@ __all__ = [
     "format_version",
     "measure_error",
     "read_bvh",
+    "write_bank",
 ]

@@ -26,20 +26,8 @@ double rate_arg(const PyClip& c, const py::object& fps) {
   return r;
 }
 
-// The bytes of a buffer in C order: a strided or reversed view (memoryview(b)[::-1]) is
-// copied element by element as Python would (bytes(view)), never read past its memory.
-std::vector<uint8_t> buffer_bytes(const py::object& source) {
-  Py_buffer view;
-  if (PyObject_GetBuffer(source.ptr(), &view, PyBUF_FULL_RO) != 0) throw py::error_already_set();
-  std::vector<uint8_t> bytes(size_t(view.len));
-  const int r = PyBuffer_ToContiguous(bytes.data(), &view, view.len, 'C');
-  PyBuffer_Release(&view);
-  if (r != 0) throw py::error_already_set();
-  return bytes;
-}
-
 // Blanks (and a UTF-8 byte order mark), then HIERARCHY in any case: what the BVH reader takes.
-bool starts_like_bvh(const std::vector<uint8_t>& b) {
+bool starts_like_bvh(std::span<const uint8_t> b) {
   size_t i = b.size() >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF ? 3 : 0;
   while (i < b.size() && (b[i] == ' ' || (b[i] >= '\t' && b[i] <= '\r'))) ++i;
   static const char word[] = "hierarchy";
@@ -48,31 +36,36 @@ bool starts_like_bvh(const std::vector<uint8_t>& b) {
   return true;
 }
 
-std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
-  auto c = std::make_shared<PyClip>();
-  std::vector<uint8_t> bytes;
-  const bool in_memory = py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source) ||
-                         py::isinstance<py::memoryview>(source);
-  if (in_memory) {
-    bytes = buffer_bytes(source);
-  } else {
-    c->file = path_of(source);
-  }
-  py::gil_scoped_release unlocked;
-  if (c->file) bytes = offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
+// A .kanim's bytes as a clip, or keyanim.Error naming `file` ("" for bytes).
+void load_bytes(std::span<const uint8_t> bytes, const std::optional<std::string>& file, RigCache* rigs, PyClip& c) {
   ErrorInfo info;
   DecodeLimits limits;
   limits.check_content = true;  // a runtime-profile file is checked as thoroughly as an archive one
-  if (Clip::load(bytes, c->clip, &info, limits, rigs) != Status::ok) {
+  if (Clip::load(bytes, c.clip, &info, limits, rigs) != Status::ok) {
     // A BVH file given where a .kanim goes: say where it goes instead of "bad signature".
     if (starts_like_bvh(bytes))
       throw offline::Error(offline::ErrorKind::malformed,
                            "is BVH text, not a .kanim: read it with keyanim.read_bvh(path), then keyanim.encode(motion) "
                            "for a .kanim's bytes or keyanim.Clip.from_motion(motion) for a clip of its frames",
-                           c->file.value_or(""));
-    throw offline::Error::kanim(c->file.value_or(""), info);
+                           file.value_or(""));
+    throw offline::Error::kanim(file.value_or(""), info);
   }
-  c->bytes = bytes.size();
+  c.bytes = bytes.size();
+}
+
+std::shared_ptr<PyClip> load(const py::object& source, RigCache* rigs) {
+  auto c = std::make_shared<PyClip>();
+  if (is_bytes_like(source)) {
+    const BufferBytes buffer(source);
+    py::gil_scoped_release unlocked;
+    load_bytes(buffer.bytes(), std::nullopt, rigs, *c);
+    return c;
+  }
+  c->file = path_of(source);
+  py::gil_scoped_release unlocked;
+  const std::vector<uint8_t> bytes =
+      offline::read_file_guarded(*c->file, offline::InputKind::kanim_or_stop, kMaxInputBytes, kLimitHint);  // the CLI's guards
+  load_bytes(bytes, c->file, rigs, *c);
   return c;
 }
 
@@ -161,6 +154,20 @@ const char* const kClipDoc =
     "file order.";
 
 }  // namespace
+
+std::shared_ptr<PyMotion> clip_to_motion(const Clip& clip, const py::object& fps) {
+  offline::ResampleOptions options;
+  if (!fps.is_none()) options.fps = fps.cast<double>();
+  // As decode --fps: a rate whose frame time 1/fps is not a positive finite number (1e-320)
+  // would write Frame Time: inf, which no reader takes back.
+  if (!fps.is_none() && !(options.fps > 0.0 && std::isfinite(options.fps) && std::isfinite(1.0 / options.fps)))
+    throw offline::Error(offline::ErrorKind::invalid_argument,
+                         "fps must be a positive number with a finite frame time 1/fps, got " + std::string(py::repr(fps)));
+  auto out = std::make_shared<PyMotion>();
+  py::gil_scoped_release unlocked;
+  out->motion = offline::decode_motion(clip, options);
+  return out;
+}
 
 void register_clip(py::module_& m) {
   py::class_<PyClip, std::shared_ptr<PyClip>> cls(m, "Clip", kClipDoc);
@@ -346,19 +353,7 @@ void register_clip(py::module_& m) {
       "to_motion(fps), clamped to the clip: what Dataset samples at a rate.");
   cls.def(
       "to_motion",
-      [](const PyClip& c, const py::object& fps) {
-        offline::ResampleOptions options;
-        if (!fps.is_none()) options.fps = fps.cast<double>();
-        // As decode --fps: a rate whose frame time 1/fps is not a positive finite number (1e-320)
-        // would write Frame Time: inf, which no reader takes back.
-        if (!fps.is_none() && !(options.fps > 0.0 && std::isfinite(options.fps) && std::isfinite(1.0 / options.fps)))
-          throw offline::Error(offline::ErrorKind::invalid_argument,
-                               "fps must be a positive number with a finite frame time 1/fps, got " + std::string(py::repr(fps)));
-        auto out = std::make_shared<PyMotion>();
-        py::gil_scoped_release unlocked;
-        out->motion = offline::decode_motion(c.clip, options);
-        return out;
-      },
+      [](const PyClip& c, const py::object& fps) { return clip_to_motion(c.clip, fps); },
       py::arg("fps") = py::none(),
       "Decodes the clip to a Motion: at the source frames (fps=None), or at frames every 1/fps\n"
       "seconds from the start up to the end (motion tweening: the in-betweens come from the curves).");

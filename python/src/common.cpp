@@ -6,6 +6,33 @@
 
 namespace keyanim::python {
 
+BufferBytes::BufferBytes(const py::handle& source) {
+  if (PyObject_GetBuffer(source.ptr(), &view_, PyBUF_FULL_RO) != 0) throw py::error_already_set();
+  // bytes cannot change: read in place. Anything else (bytearray, a writable memoryview) is
+  // copied, since another thread may write it while the GIL is released.
+  if (PyBytes_CheckExact(source.ptr())) {
+    bytes_ = {static_cast<const uint8_t*>(view_.buf), size_t(view_.len)};
+    return;
+  }
+  try {
+    copy_.resize(size_t(view_.len));
+  } catch (...) {
+    PyBuffer_Release(&view_);
+    throw;
+  }
+  if (PyBuffer_ToContiguous(copy_.data(), &view_, view_.len, 'C') != 0) {
+    PyBuffer_Release(&view_);
+    throw py::error_already_set();
+  }
+  bytes_ = copy_;
+}
+
+BufferBytes::~BufferBytes() { PyBuffer_Release(&view_); }
+
+bool is_bytes_like(const py::handle& source) {
+  return py::isinstance<py::bytes>(source) || py::isinstance<py::bytearray>(source) || py::isinstance<py::memoryview>(source);
+}
+
 py::str text(const std::string& bytes) {
   PyObject* s = PyUnicode_DecodeUTF8(bytes.data(), py::ssize_t(bytes.size()), "surrogateescape");
   if (s == nullptr) throw py::error_already_set();

@@ -5,7 +5,11 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <span>
+#include <string_view>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,6 +40,26 @@ struct PyClip {
 // The most read from one file (read_bvh, Clip): the CLI's default --max-input, 1 GiB.
 inline constexpr uint64_t kMaxInputBytes = uint64_t(1) << 30;
 inline constexpr const char* kLimitHint = "the module reads at most 1 GiB of a file";
+
+// The bytes of a buffer (bytes, bytearray, memoryview, ...) for as long as this lives: a bytes
+// object's in place, any other buffer copied in C order as bytes(view) would (a strided or
+// reversed view, memoryview(b)[::-1], is never read past its memory), so that the span may be
+// read with the GIL released while other threads run. Destroy it with the GIL held.
+class BufferBytes {
+ public:
+  explicit BufferBytes(const py::handle& source);
+  ~BufferBytes();
+  BufferBytes(const BufferBytes&) = delete;
+  BufferBytes& operator=(const BufferBytes&) = delete;
+  std::span<const uint8_t> bytes() const { return bytes_; }
+
+ private:
+  Py_buffer view_{};
+  std::vector<uint8_t> copy_;
+  std::span<const uint8_t> bytes_;
+};
+// bytes, bytearray or memoryview: what Clip and Bank take as a file's bytes (rather than a path).
+bool is_bytes_like(const py::handle& source);
 
 // Text from files (joint names, notes) may hold any bytes: bytes that are not UTF-8 become
 // lone surrogates (PEP 383, "surrogateescape"), as `keyanim ... --json` writes them.
@@ -75,6 +99,18 @@ FrameList frames_arg(const py::handle& frames, uint32_t frame_count);
 template <class Class, class Get>
 void def_skeleton_properties(Class& cls, Get skeleton_of);
 
+// An output written by the module's rule (the CLI's): through a temporary file beside `path`,
+// renamed over it once complete; an existing file is replaced only with overwrite (else
+// FileExistsError); a device, a FIFO or a link to one, or to a standard stream, is written in
+// place (in_place.h), never renamed over. check_output refuses the existing file (call it before
+// anything else can fail); write_output calls `produce` with a function that writes a chunk.
+using Put = std::function<void(std::string_view)>;
+void check_output(const std::string& path, bool overwrite);
+void write_output(const std::string& path, const std::function<void(const Put&)>& produce);
+
+// Clip.to_motion (and Bank.to_motion): the clip decoded at its frames or at a rate.
+std::shared_ptr<PyMotion> clip_to_motion(const Clip& clip, const py::object& fps);
+
 // keyanim.read_bvh: a BVH file (str, bytes or os.PathLike) as a Motion, through the CLI's guards.
 PyMotion read_bvh_path(const py::object& path);
 
@@ -87,6 +123,7 @@ void register_errors(py::module_& m);
 void register_motion(py::module_& m);
 void register_encode(py::module_& m);
 void register_clip(py::module_& m);
+void register_bank(py::module_& m);
 
 }  // namespace keyanim::python
 

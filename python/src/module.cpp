@@ -14,4 +14,5 @@ PYBIND11_MODULE(_keyanim, m) {
   register_motion(m);
   register_encode(m);
   register_clip(m);
+  register_bank(m);
 }

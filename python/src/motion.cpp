@@ -1,17 +1,9 @@
 // keyanim.read_bvh, keyanim.Motion (its channels as a numpy view, BVH writing, forward
 // kinematics) and keyanim.measure_error.
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 
 #include "common.h"
 #include "keyanim/offline/guarded_read.h"
-#include "keyanim/offline/in_place.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/error.h"
@@ -46,13 +38,9 @@ PyMotion read_bvh_path(const py::object& path_arg) {
 
 namespace {
 
-// Writes through a temporary file beside `path`, renamed over it once complete; an existing
-// file is replaced only with overwrite. A device, a FIFO or a link to one, or to a standard
-// stream, is written in place (the CLI's rule, in_place.h), never renamed over.
+// As BVH text, by the module's output rule (write_output).
 void write_bvh_file(const offline::Motion& motion, const std::string& path, bool overwrite) {
-  std::error_code ec;
-  if (!overwrite && std::filesystem::symlink_status(path, ec).type() != std::filesystem::file_type::not_found && !ec)
-    throw offline::Error::io(path, "exists (pass overwrite=True to replace it)", EEXIST);
+  check_output(path, overwrite);
   // BVH text holds finite numbers only: nan or inf (set through `channels`) would write a file
   // that no reader takes back.
   if (!std::isfinite(motion.frame_time) || motion.frame_time < 0.0)
@@ -65,35 +53,11 @@ void write_bvh_file(const offline::Motion& motion, const std::string& path, bool
                                std::to_string(i / motion.channel_count()) + " is " + offline::general_text(motion.values[i]) +
                                ": BVH text holds finite numbers only",
                            path);
-  int fd = offline::open_in_place(path);
-  if (fd == -2) throw offline::Error::io(path, "cannot open", errno);
-  std::string temp;
-  if (fd < 0) {
-    const std::filesystem::path target(path);
-    const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
-    temp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
-    fd = mkstemp(temp.data());
-    if (fd < 0) throw offline::Error::io(path, "cannot create a temporary file beside it", errno);
-  }
-  int failed = 0;
-  auto put = [&](std::string_view chunk) {
-    for (size_t done = 0; done < chunk.size() && !failed;) {
-      const ssize_t n = ::write(fd, chunk.data() + done, chunk.size() - done);
-      if (n < 0 && errno != EINTR) failed = errno;
-      if (n == 0) failed = EIO;
-      if (n > 0) done += size_t(n);
-    }
-  };
-  offline::BvhWriter writer(motion.skeleton, motion.frame_count, motion.frame_time, put);
-  for (uint32_t f = 0; f < motion.frame_count && !failed; ++f) writer.frame(motion.frame(f));
-  writer.finish();
-  if (!failed && !temp.empty() && ::fchmod(fd, 0644) != 0) failed = errno;
-  if (::close(fd) != 0 && !failed) failed = errno;
-  if (!failed && !temp.empty() && std::rename(temp.c_str(), path.c_str()) != 0) failed = errno;
-  if (failed) {
-    if (!temp.empty()) std::remove(temp.c_str());
-    throw offline::Error::io(path, "cannot write", failed);
-  }
+  write_output(path, [&](const Put& put) {
+    offline::BvhWriter writer(motion.skeleton, motion.frame_count, motion.frame_time, put);
+    for (uint32_t f = 0; f < motion.frame_count; ++f) writer.frame(motion.frame(f));
+    writer.finish();
+  });
 }
 
 // Per frame of `frames`, `per_node` values for every node, from `pose(row, node, out)`.

@@ -111,7 +111,7 @@ def test_bad_arguments(keyanim, library, tmp_path):
                    dict(position_channels="x")):
         with pytest.raises(ValueError):
             keyanim.Dataset(library, **kwargs)
-    with pytest.raises(ValueError, match="no .kanim or .bvh"):
+    with pytest.raises(ValueError, match="no .kanim, .kbank or .bvh"):
         keyanim.Dataset(tmp_path)
     ds = keyanim.Dataset(library, window=64)
     for bad in (len(ds), -len(ds) - 1):

@@ -10,8 +10,8 @@ from conftest import REPO
 
 
 def test_exports_and_versions():
-    assert set(keyanim.__all__) == {"Clip", "Dataset", "Error", "Motion", "RigCache", "encode", "format_version",
-                                    "measure_error", "read_bvh"}
+    assert set(keyanim.__all__) == {"Bank", "Clip", "Dataset", "Error", "Motion", "RigCache", "encode",
+                                    "format_version", "measure_error", "read_bvh", "write_bank"}
     assert re.fullmatch(r"\d+\.\d+\.\d+", keyanim.__version__)
     assert re.fullmatch(r"\d+\.\d+", keyanim.format_version)
     assert issubclass(keyanim.Error, ValueError)

@@ -15,7 +15,7 @@
 
 namespace keyanim::cli {
 
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, const std::vector<std::string>& extensions) {
   namespace fs = std::filesystem;
   std::vector<std::string> out;
   for (const std::string& in : inputs) {
@@ -29,7 +29,8 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
          it.increment(ec)) {
       std::string ext = it->path().extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-      if (it->is_regular_file(ec) && ext == ".bvh") found.push_back(it->path().string());
+      if (it->is_regular_file(ec) && std::find(extensions.begin(), extensions.end(), ext) != extensions.end())
+        found.push_back(it->path().string());
     }
     if (ec) fail(kBadInput, in + ": cannot list: " + ec.message());
     std::sort(found.begin(), found.end());

@@ -9,8 +9,10 @@
 
 namespace keyanim::cli {
 
-// Expands directories into their *.bvh files (recursively, sorted); files stay as given.
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
+// Expands directories into their files of these extensions (lower case; recursively, sorted;
+// any case of the extension matches); files stay as given.
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs,
+                                       const std::vector<std::string>& extensions = {".bvh"});
 
 // Runs job(i) for every i < count on `threads` threads (0: all cores). A job reports failure
 // by throwing cli::Failure; the failure is printed (unless silenced by the caller) and the

@@ -10,6 +10,7 @@
 #include <new>
 #include <system_error>
 
+#include "bank_io.h"
 #include "escape.h"
 #include "keyanim/offline/bvh.h"
 #include "progress.h"
@@ -178,6 +179,8 @@ Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, cons
   limits.max_keys = std::min(limits.max_keys, g.limits.max_values);
   limits.check_content = true;  // a tool reads a runtime-profile file as thoroughly as an archive one
   const Status s = Clip::load(bytes, clip, &info, limits);
+  if (s == Status::invalid_argument && looks_like_bank(bytes))
+    fail(kBadInput, path + ": a bank of many clips: name one as " + path + ":NAME (keyanim list " + path + " lists them)");
   if (s != Status::ok) {
     const int code = s == Status::unsupported_version ? kUnsupported : s == Status::limit_exceeded ? kLimit : kBadInput;
     fail(code, offline::Error::kanim(path, info).what() +
@@ -189,6 +192,10 @@ Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, cons
 }
 
 std::string swap_extension(const std::string& path, const std::string& ext) {
+  // A bank's clip, LIB.kbank:NAME: beside the bank, after the last part of NAME (lib/walk.bvh
+  // for lib/data.kbank:cmu/walk), not after the bank's own name.
+  if (const std::optional<MemberPath> m = member_path(path))
+    return swap_extension((std::filesystem::path(m->bank).parent_path() / std::filesystem::path(m->name).filename()).string(), ext);
   std::filesystem::path p(path);
   p.replace_extension(ext);
   return p.string();

@@ -109,7 +109,7 @@ offline::Motion load_bvh_bytes(const std::string& path, const std::vector<uint8_
 // more keys than --max-values) naming section and offset.
 Clip load_kanim(const std::string& path, const std::vector<uint8_t>& bytes, const Globals& g);
 
-// "walk.bvh" + ".kanim" -> "walk.kanim"
+// "walk.bvh" + ".kanim" -> "walk.kanim" (LIB.kbank:NAME: beside the bank, named after NAME)
 std::string swap_extension(const std::string& path, const std::string& ext);
 
 }  // namespace keyanim::cli

@@ -19,6 +19,9 @@ int cmd_eval(const Argv& argv, Globals& g);
 int cmd_verify(const Argv& argv, Globals& g);
 int cmd_view(const Argv& argv, Globals& g);
 int cmd_convert(const Argv& argv, Globals& g);
+int cmd_pack(const Argv& argv, Globals& g);
+int cmd_list(const Argv& argv, Globals& g);
+int cmd_unpack(const Argv& argv, Globals& g);
 
 extern const char* const kEncodeHelp;
 extern const char* const kDecodeHelp;
@@ -30,5 +33,8 @@ extern const char* const kEvalHelp;
 extern const char* const kVerifyHelp;
 extern const char* const kViewHelp;
 extern const char* const kConvertHelp;
+extern const char* const kPackHelp;
+extern const char* const kListHelp;
+extern const char* const kUnpackHelp;
 
 }  // namespace keyanim::cli

@@ -157,8 +157,10 @@ std::optional<FileId> input_id(const std::string& path) {
   return regular_id(st);
 }
 
-Input::Input(const std::string& path, const Globals& g) : path_(path), max_bytes_(g.limits.max_input_bytes) {
+Input::Input(const std::string& path, const Globals& g)
+    : path_(path), member_(member_path(path)), globals_(&g), max_bytes_(g.limits.max_input_bytes) {
   struct stat st;
+  const std::string& file = member_ ? member_->bank : path;
   if (path == "-") {
     fd_ = STDIN_FILENO;
     if (::fstat(fd_, &st) != 0) fail(kBadInput, "-: cannot read: " + std::string(std::strerror(errno)));
@@ -167,7 +169,7 @@ Input::Input(const std::string& path, const Globals& g) : path_(path), max_bytes
       fail(kLimit, "-: larger than the input limit of " + std::to_string(max_bytes_) + " bytes (" + kLimitHint + ")");
     id_ = regular_id(st);
   } else {
-    const offline::OpenedInput in = guarded([&] { return offline::open_guarded(path, max_bytes_, kLimitHint); });
+    const offline::OpenedInput in = guarded([&] { return offline::open_guarded(file, max_bytes_, kLimitHint); });
     fd_ = in.fd;
     if (::fstat(fd_, &st) == 0) id_ = regular_id(st);
   }
@@ -183,6 +185,12 @@ Input::~Input() {
 }
 
 std::vector<uint8_t> Input::read(Kind kind) {
+  if (member_) {
+    const std::vector<uint8_t> bank = guarded([&] {
+      return offline::read_guarded(fd_, member_->bank, Kind::kanim, max_bytes_, size_hint_, kLimitHint);
+    });
+    return member_file(*member_, bank, *globals_);
+  }
   return guarded([&] { return offline::read_guarded(fd_, path_, kind, max_bytes_, size_hint_, kLimitHint); });
 }
 

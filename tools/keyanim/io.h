@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bank_io.h"
 #include "cli.h"
 #include "keyanim/offline/guarded_read.h"
 
@@ -40,6 +41,7 @@ class Input {
  public:
   // Opens `path` ("-": standard input): exit 2 if it cannot be opened or is a directory, 6 if
   // it is a regular file larger than --max-input, 4 if standard output is this very file.
+  // LIB:NAME (bank_io.h) opens the bank LIB, and read() gives its clip NAME as a .kanim file.
   Input(const std::string& path, const Globals& g);
   ~Input();
   Input(const Input&) = delete;
@@ -52,6 +54,8 @@ class Input {
 
  private:
   std::string path_;
+  std::optional<MemberPath> member_;  // LIB:NAME
+  const Globals* globals_ = nullptr;
   int fd_ = -1;
   std::optional<FileId> id_;
   uint64_t max_bytes_ = 0;

@@ -34,6 +34,9 @@ const Command kCommands[] = {
     {"render", cmd_render, &kRenderHelp, Command::all, "SVG: one frame as a stick figure, front and side view"},
     {"eval", cmd_eval, &kEvalHelp, Command::all_but_error, "compression against error for files and tolerances"},
     {"convert", cmd_convert, &kConvertHelp, Command::none, ".kanim -> .kanim in the other profile: runtime (sampled in place) or archive"},
+    {"pack", cmd_pack, &kPackHelp, Command::all, "many clips into one bank (.kbank): each skeleton once, clips by name"},
+    {"list", cmd_list, &kListHelp, Command::none, "the clips of a bank, from its index"},
+    {"unpack", cmd_unpack, &kUnpackHelp, Command::none, "every clip of a bank as a .kanim file of its own"},
     {"verify", cmd_verify, &kVerifyHelp, Command::none, "check a .kanim, and its error against the original"},
     {"view", cmd_view, &kViewHelp, Command::none, "HTML page that plays a .kanim in the browser (3D skeleton)"},
 };

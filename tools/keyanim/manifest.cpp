@@ -42,6 +42,18 @@ Shard parse_shard(const std::string& text) {
   return s;
 }
 
+std::string read_manifest(const std::string& list) {
+  std::string text;
+  if (list == "-") {
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+  } else {
+    std::ifstream in(list, std::ios::binary);
+    if (!in) fail(kBadInput, list + ": cannot open the list: " + std::strerror(errno));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return text;
+}
+
 std::vector<std::string> manifest_entries(const std::string& text) {
   std::vector<std::string> out;
   std::istringstream in(text);
@@ -163,15 +175,7 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
   const bool skip_existing = args.has("--skip-existing");
   const std::string report_path = args.get("--report").value_or("");
 
-  std::string text;
-  if (list == "-") {
-    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-  } else {
-    std::ifstream in(list, std::ios::binary);
-    if (!in) fail(kBadInput, list + ": cannot open the list: " + std::strerror(errno));
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  const std::vector<std::string> all = distinct(manifest_entries(text));
+  const std::vector<std::string> all = distinct(manifest_entries(read_manifest(list)));
   check_manifest_outputs(all, outdir, report_path);
   std::vector<std::string> inputs;
   // (i + count could wrap around with a huge N and take every entry: step only while it fits.)

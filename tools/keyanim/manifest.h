@@ -25,6 +25,8 @@ Shard parse_shard(const std::string& text);
 
 // The list's entries: one path per line (a trailing CR dropped), empty lines skipped.
 std::vector<std::string> manifest_entries(const std::string& text);
+// The list's text ('-': standard input); exit 2 if it cannot be opened.
+std::string read_manifest(const std::string& list);
 
 // Where an input's output goes: its path, made relative (an absolute path loses its root, a
 // path climbing out of the current directory is made absolute first), below `outdir`, with

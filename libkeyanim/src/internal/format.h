@@ -17,6 +17,9 @@ inline constexpr size_t kRuntimeChecksumSize = 8;  // XXH64 (the runtime profile
 // is Runtime (the runtime profile, section 9).
 inline constexpr uint32_t kHeaderReservedMask = 0x0000FFFFu;
 inline constexpr uint32_t kHeaderRuntime = 1u << 0;
+// From version 4.1 (section 10): bit 1 Member (a bank's clip), bit 2 Bank (a bank's header).
+inline constexpr uint32_t kHeaderMember = 1u << 1;
+inline constexpr uint32_t kHeaderBank = 1u << 2;
 inline constexpr uint16_t kRuntimeVersionMajor = 4;  // the first version with the runtime profile
 // Section_Flags.
 inline constexpr uint32_t kSectionCompressed = 1u << 0;
@@ -39,6 +42,10 @@ inline constexpr uint32_t kTagImag = make_tag('I', 'M', 'A', 'G');
 // runtime profile's (entries 0 and 1 exactly, so that IMAG starts 8-aligned: section 9.1).
 inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTagKtim, kTagKval};
 inline constexpr uint32_t kRuntimeTags[3] = {kTagClip, kTagImag, kTagSkel};
+// A bank's member has no SKEL (section 10.5): the archive profile's critical sections without
+// it (kMemberSlots: their places in kCriticalTags), and the runtime profile's first two.
+inline constexpr uint32_t kMemberTags[4] = {kTagClip, kTagChan, kTagKtim, kTagKval};
+inline constexpr int kMemberSlots[4] = {0, 2, 3, 4};
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count

@@ -12,7 +12,7 @@
 
 namespace keyanim::offline {
 
-std::vector<uint8_t> write_kanim_runtime(const Clip& clip) {
+std::vector<Section> runtime_sections(const Clip& clip) {
   const internal::Image& img = ClipAccess::image(clip);
   std::vector<Section> sections;
   auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes) {
@@ -24,7 +24,11 @@ std::vector<uint8_t> write_kanim_runtime(const Clip& clip) {
   add(internal::kTagImag, 0, {img.imag.begin(), img.imag.end()});
   add(internal::kTagSkel, 0, skel_section(clip.skeleton()));
   if (!img.notes.empty()) add(internal::kTagNote, internal::kSectionAncillary, {img.notes.begin(), img.notes.end()});
-  std::vector<uint8_t> out = assemble(sections, kRuntimeFormatVersionMajor, kRuntimeFormatVersionMinor,
+  return sections;
+}
+
+std::vector<uint8_t> write_kanim_runtime(const Clip& clip) {
+  std::vector<uint8_t> out = assemble(runtime_sections(clip), kRuntimeFormatVersionMajor, kRuntimeFormatVersionMinor,
                                       internal::kHeaderRuntime, internal::kRuntimeChecksumSize);
   internal::put_le<uint64_t>(out, internal::xxh64_of(out.data(), out.size()));
   return out;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -132,12 +133,6 @@ std::vector<uint8_t> kval_section(const std::vector<EncodedChannel>& chans, cons
   return s;
 }
 
-// zstd's parameters for one section: a level, and a minimum match length (0: the level's).
-struct Zstd {
-  int level = 0;  // <= 0: stored raw
-  int min_match = 0;
-};
-
 // Without a level from the caller, each section at the cheapest parameters measured to keep
 // its bytes: over the 42 corpus files (0.05% / 0.5% of the skeleton size), against -19 on
 // every section (1,316,838 / 520,860 bytes) and counted by callgrind on CMU 01_01 and Bandai
@@ -154,7 +149,7 @@ constexpr Zstd kSkelZstd{15, 0}, kChanZstd{15, 0}, kKtimZstd{15, 6}, kKvalZstd{1
 // Compresses `raw` as one zstd frame, ending a zstd block at each of `breaks` (offsets) so
 // that streams of different statistics (the KVAL planes) get their own entropy tables.
 Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZSTD_CCtx* cctx, Zstd z,
-                     const std::vector<size_t>& breaks = {}) {
+                     const std::vector<size_t>& breaks, std::span<const uint8_t> dictionary) {
   Section sec;
   sec.tag = tag;
   sec.flags = flags;
@@ -166,6 +161,7 @@ Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZST
     if (z.min_match > 0) ZSTD_CCtx_setParameter(cctx, ZSTD_c_minMatch, z.min_match);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);  // the spec requires it
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);     // the file has its own CRC
+    if (!dictionary.empty()) ZSTD_CCtx_loadDictionary(cctx, dictionary.data(), dictionary.size());  // a bank's (section 10.4)
     ZSTD_CCtx_setPledgedSrcSize(cctx, raw.size());
     ZSTD_outBuffer out{out_bytes.data(), out_bytes.size(), 0};
     bool ok = true;
@@ -193,6 +189,8 @@ Section make_section(uint32_t tag, uint32_t flags, std::vector<uint8_t> raw, ZST
   return sec;
 }
 
+}  // namespace
+
 uint32_t crc32_of(const uint8_t* p, size_t n) {
   uLong crc = crc32(0L, Z_NULL, 0);
   while (n > 0) {  // zlib takes uInt lengths
@@ -203,6 +201,8 @@ uint32_t crc32_of(const uint8_t* p, size_t n) {
   }
   return static_cast<uint32_t>(crc);
 }
+
+namespace {
 
 // The first rule of spec/FORMAT.md that `clip` breaks, or "".
 std::string first_broken_rule(const EncodedClip& clip) {
@@ -298,7 +298,7 @@ void validate_encoded_clip(const EncodedClip& clip) {
   if (std::string rule = first_broken_rule(clip); !rule.empty()) throw Error(ErrorKind::invalid_argument, rule);
 }
 
-std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level) {
+std::vector<RawSection> archive_raw_sections(const EncodedClip& clip, std::optional<int> zstd_level) {
   validate_encoded_clip(clip);
   uint64_t keys = 0;
   for (const auto& c : clip.channels) keys += c.frames.size();
@@ -307,13 +307,7 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zst
   auto zstd = [&](Zstd measured) {
     return zstd_level ? Zstd{std::min(*zstd_level, ZSTD_maxCLevel()), 0} : measured;
   };
-  struct Raw {
-    uint32_t tag, flags;
-    std::vector<uint8_t> bytes;
-    Zstd z;
-    std::vector<size_t> breaks;
-  };
-  std::vector<Raw> raw;
+  std::vector<RawSection> raw;
   auto add = [&](uint32_t tag, uint32_t flags, std::vector<uint8_t> bytes, Zstd z) {
     raw.push_back({tag, flags, std::move(bytes), z, {}});
   };
@@ -329,6 +323,10 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zst
   raw.back().breaks = std::move(breaks);
   if (!clip.notes.empty())
     add(internal::kTagNote, internal::kSectionAncillary, {clip.notes.begin(), clip.notes.end()}, zstd(kNoteZstd));
+  return raw;
+}
+
+std::vector<Section> compress_sections(std::vector<RawSection> raw, std::span<const uint8_t> dictionary) {
   // One section after another, in one zstd context: a context's tables at the higher levels
   // are tens of MB, and two at once made the peak of `keyanim encode -j 2` on a 44,032-frame
   // clip (120 MB against 99 MB with one; the encoder's own peak is 98 MB). KTIM is most of
@@ -338,10 +336,20 @@ std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zst
   for (size_t i = 0; i < raw.size(); ++i) {
     if (raw[i].z.level > 0 && cctx == nullptr) cctx = ZSTD_createCCtx();
     sections[i] = make_section(raw[i].tag, raw[i].flags, std::move(raw[i].bytes), raw[i].z.level > 0 ? cctx : nullptr,
-                               raw[i].z, raw[i].breaks);
+                               raw[i].z, raw[i].breaks, dictionary);
   }
   ZSTD_freeCCtx(cctx);
+  return sections;
+}
 
+Section stored_skel(std::vector<uint8_t> skel) {
+  std::vector<RawSection> raw(1);
+  raw[0] = {internal::kTagSkel, 0, std::move(skel), kSkelZstd, {}};
+  return std::move(compress_sections(std::move(raw), {})[0]);
+}
+
+std::vector<uint8_t> write_kanim(const EncodedClip& clip, std::optional<int> zstd_level) {
+  const std::vector<Section> sections = compress_sections(archive_raw_sections(clip, zstd_level), {});
   std::vector<uint8_t> out = assemble(sections, kFormatVersionMajor, kFormatVersionMinor, 0, internal::kChecksumSize);
   put_le<uint32_t>(out, crc32_of(out.data(), out.size()));
   return out;

@@ -15,6 +15,7 @@
 #include "runtime/clip_access.h"
 #include "runtime/image.h"
 #include "runtime/load/loader.h"
+#include "runtime/load/member.h"
 #include "runtime/rig_cache_access.h"
 
 namespace keyanim {
@@ -38,7 +39,11 @@ Status Loader::run(ClipSource& parts) {
       for (int k = 0; k < 5; ++k) {
         if (critical_index_[k] != static_cast<int>(i)) continue;
         switch (k) {
-          case 0: s = get_content(e, "CLIP", c, 0, &parts); if (s == Status::ok) s = parse_clip(c, parts); break;
+          case 0:
+            s = get_content(e, "CLIP", c, 0, &parts);
+            if (s == Status::ok) s = parse_clip(c, parts);
+            if (s == Status::ok && member_ != nullptr && (s = get_skel(-1, c)) == Status::ok) s = parse_skel(c, parts);
+            break;
           case 1: s = get_content(e, "SKEL", c, 1, &parts); if (s == Status::ok) s = parse_skel(c, parts); break;
           case 2: s = get_content(e, "CHAN", c, 2, &parts); if (s == Status::ok) s = parse_chan(c, parts); break;
           case 3: s = get_content(e, "KTIM", c, 3, &parts); if (s == Status::ok) s = parse_ktim(c, parts); break;
@@ -62,7 +67,7 @@ Status Loader::run_runtime(ClipSource& parts) {
   if (s == Status::ok) s = parse_clip(c, parts);
   if (s == Status::ok) s = get_content(table_[1], "IMAG", imag_);
   if (s == Status::ok) s = check_image(imag_, parts);
-  if (s == Status::ok) s = get_content(table_[static_cast<size_t>(critical_index_[2])], "SKEL", skel_);
+  if (s == Status::ok) s = get_skel(critical_index_[2], skel_);
   if (s == Status::ok && rigs_ != nullptr) rig_ = RigCacheAccess::find_skel(*rigs_, skel());
   // Equal SKEL bytes were parsed and checked once; CLIP's counts must still agree with them.
   if (rig_ != nullptr && (rig_->skeleton.joints.size() != node_count_ || rig_->skeleton.channel_count() != channel_count_))
@@ -98,9 +103,10 @@ bool says_runtime(std::span<const uint8_t> bytes) noexcept {
 
 // A runtime-profile file whose structure passed: its image over `bytes` (which `storage` owns,
 // or the caller), then the content rules if asked for.
+// `base`: where `bytes` start in what the caller reports offsets from (a bank's member).
 Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t> bytes,
                     std::shared_ptr<const void> storage, const DecodeLimits& limits, RigCache* rigs, Clip& out,
-                    ErrorInfo* err) {
+                    ErrorInfo* err, uint64_t base = 0) {
   const uint64_t keys = loader.key_count();
   const std::span<const uint8_t> imag = loader.image();
   // Before the call: an argument list may move `storage` before it reads it (clang does).
@@ -110,13 +116,37 @@ Status runtime_clip(Loader& loader, ClipSource&& parts, std::span<const uint8_t>
   if (!limits.check_content) return Status::ok;
   const Status s = out.check_content(err);
   if (s != Status::ok) {
-    if (err != nullptr) err->byte_offset = static_cast<uint64_t>(imag.data() - bytes.data());
+    if (err != nullptr) err->byte_offset = base + static_cast<uint64_t>(imag.data() - bytes.data());
     out = Clip{};
   }
   return s;
 }
 
 }  // namespace
+
+namespace internal {
+
+Status load_member(std::span<const uint8_t> bytes, const MemberContext& m, std::shared_ptr<const void> storage,
+                   const DecodeLimits& limits, RigCache* rigs, Clip& out, ErrorInfo* err) {
+  out = Clip{};
+  try {
+    ClipSource parts;
+    Loader loader(bytes, limits, err);
+    loader.use_rigs(rigs);
+    loader.use_member(&m);
+    const Status s = loader.run(parts);
+    if (s != Status::ok) return s;
+    if (!loader.runtime()) {
+      out = ClipAccess::make(internal::build_image(std::move(parts), rigs));
+      return Status::ok;
+    }
+    return runtime_clip(loader, std::move(parts), bytes, std::move(storage), limits, rigs, out, err, m.member_offset);
+  } catch (const std::bad_alloc&) {
+    return out_of_memory(out, err);
+  }
+}
+
+}  // namespace internal
 
 Status Clip::load(std::span<const uint8_t> bytes, Clip& out, ErrorInfo* err, const DecodeLimits& limits,
                   RigCache* rigs) {

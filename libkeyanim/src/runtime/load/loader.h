@@ -44,6 +44,19 @@ struct DctxDeleter {
   void operator()(ZSTD_DCtx* d) const noexcept { ZSTD_freeDCtx(d); }
 };
 
+// A bank's member (spec/FORMAT.md section 10.5): its skeleton is the bank's (`skel`, at
+// `skel_offset` in the bank), its compressed sections are made with `dictionary` (or none), and
+// failures are reported at offsets from the bank's first byte (the member starts at
+// `member_offset`).
+struct MemberContext {
+  std::span<const uint8_t> skel;
+  uint64_t skel_offset = 0;
+  bool skel_compressed = false;  // stored as a zstd frame: offsets in it are of its content
+  uint64_t member_offset = 0;
+  const ZSTD_DDict* dictionary = nullptr;
+  bool runtime = false;  // the bank's profile, which its members must have
+};
+
 class Loader {
  public:
   Loader(std::span<const uint8_t> bytes, const DecodeLimits& limits, ErrorInfo* err)
@@ -56,6 +69,9 @@ class Loader {
   // The runtime profile with a rig cache: a SKEL the cache has seen is not parsed; its rig is
   // rig() (else null, and the parsed skeleton is in `parts`). skel(): SKEL's bytes.
   void use_rigs(RigCache* rigs) noexcept { rigs_ = rigs; }
+  // The bytes are a bank's member (they must say so: section 10.5), read with `m` (which must
+  // outlive run()).
+  void use_member(const MemberContext* m) noexcept { member_ = m; }
   const std::shared_ptr<const Rig>& rig() const noexcept { return rig_; }
   std::span<const uint8_t> skel() const noexcept { return {skel_.data, skel_.size}; }
   uint64_t key_count() const noexcept { return key_count_; }
@@ -66,7 +82,10 @@ class Loader {
     if (err_ != nullptr) {
       err_->status = s;
       err_->section = section;
-      err_->byte_offset = offset;
+      // A member's offsets from the bank's first byte. (The bank's skeleton lies before the
+      // member: its content's offset is stored as skel_offset - member_offset, which wraps
+      // as u64, and this sum wraps back.)
+      err_->byte_offset = offset + (member_ != nullptr ? member_->member_offset : 0);
       err_->detail = std::move(detail);
     }
     return s;
@@ -106,6 +125,10 @@ class Loader {
   Status check_image_curves(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
   Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
   Status run_runtime(ClipSource& parts);  // run() for the runtime profile
+  // A member's skeleton as SKEL's content (MemberContext); else table entry `index`'s.
+  Status get_skel(int index, Content& out);
+  // Header_Flags: the reserved bits, and Member/Bank against how the bytes are read.
+  Status check_header_flags(uint16_t major, uint32_t flags);
   // Turns channel ch's residual r (of key i, found at section offset at) into q, checking the
   // bounds of section 4.5; q and q_prev carry the previous two.
   Status residual_to_q(const Content& c, size_t at, size_t ch, uint32_t i, uint64_t zigzag, int64_t& q,
@@ -121,6 +144,7 @@ class Loader {
   Content imag_;          // its IMAG, once checked
   Content skel_;          // its SKEL
   RigCache* rigs_ = nullptr;
+  const MemberContext* member_ = nullptr;
   std::shared_ptr<const Rig> rig_;
   std::vector<TableEntry> table_;
   int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL (runtime: CLIP, IMAG, SKEL)

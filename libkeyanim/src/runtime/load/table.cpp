@@ -50,15 +50,19 @@ Status Loader::read_header_and_table() {
                     std::to_string(kOldestFormatVersionMajor) + " to " + std::to_string(kNewestFormatVersionMajor) + ")");
   major_ = major;
   runtime_ = major >= internal::kRuntimeVersionMajor && (header_flags & internal::kHeaderRuntime) != 0;
-  if (header_flags & internal::kHeaderReservedMask & ~(major >= internal::kRuntimeVersionMajor ? internal::kHeaderRuntime : 0u))
-    return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
+  if (Status s = check_header_flags(major, header_flags); s != Status::ok) return s;
   if (reserved != 0) return fail(Status::reserved_bits_set, "header", 20, "Header_Reserved is not 0");
 
   // The table and the checksum must fit: 24 * count + 4 (8) <= size - 24, in subtraction form.
   const size_t avail = size - internal::kHeaderEnd;
   const size_t checksum_size = runtime_ ? internal::kRuntimeChecksumSize : internal::kChecksumSize;
-  const uint32_t* critical_tags = runtime_ ? internal::kRuntimeTags : internal::kCriticalTags;
-  const size_t critical_count = runtime_ ? 3 : 5;
+  // A bank's member has no SKEL (section 10.5).
+  const bool member = member_ != nullptr;
+  const uint32_t* critical_tags =
+      runtime_ ? internal::kRuntimeTags : member ? internal::kMemberTags : internal::kCriticalTags;
+  const size_t critical_count = runtime_ ? (member ? 2 : 3) : (member ? 4 : 5);
+  const std::string runtime_rule = member ? ": a runtime-profile member's sections must be CLIP and IMAG, entries 0 and 1"
+                                          : ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2";
   if (avail < checksum_size ||
       section_count > (avail - checksum_size) / internal::kTableEntrySize)
     return fail(Status::truncated, "table", size,
@@ -81,21 +85,23 @@ Status Loader::read_header_and_table() {
     size_t crit = critical_count;
     for (size_t k = 0; k < critical_count; ++k)
       if (critical_tags[k] == e.tag) crit = k;
+    if (member && e.tag == internal::kTagSkel)
+      return fail(Status::corrupt, "table", e.entry_offset, name + ": a bank's member holds no SKEL (its skeleton is the bank's)");
     if (runtime_ && (e.flags & internal::kSectionCompressed))
       return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": no section of the runtime profile is compressed");
     if (runtime_ && crit == critical_count && e.tag != internal::kTagNote)  // whatever its flags
       for (uint32_t tag : internal::kCriticalTags)
         if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
     if (runtime_ && i < critical_count && e.tag != critical_tags[i])
-      return fail(Status::corrupt, "table", e.entry_offset,
-                  name + ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2");
+      return fail(Status::corrupt, "table", e.entry_offset, name + runtime_rule);
     if (crit < critical_count) {
       if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
       if (crit != next_critical || (runtime_ && i != crit))
         return fail(Status::corrupt, "table", e.entry_offset,
-                    name + (runtime_ ? ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2"
+                    name + (runtime_  ? runtime_rule
+                            : member ? ": a member's critical sections must be CLIP, CHAN, KTIM, KVAL, once each, in this order"
                                      : ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order"));
-      critical_index_[crit] = static_cast<int>(i);
+      critical_index_[member && !runtime_ ? internal::kMemberSlots[crit] : static_cast<int>(crit)] = static_cast<int>(i);
       ++next_critical;
     } else if (e.tag == internal::kTagNote) {
       if (!ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": NOTE must be ancillary");
@@ -119,8 +125,12 @@ Status Loader::read_header_and_table() {
     return fail(Status::trailing_bytes, "checksum", pos + checksum_size,
                 std::to_string(size - pos - checksum_size) + " bytes after the checksum");
 
-  // Everything this decoder will decompress or copy, before anything is.
-  uint64_t raw_total = 0;
+  // Everything this decoder will decompress or copy, before anything is (a member's skeleton
+  // counts as its SKEL: rule 10.5.3).
+  uint64_t raw_total = member ? member_->skel.size() : 0;
+  if (raw_total > limits_.max_decompressed_bytes)
+    return fail(Status::limit_exceeded, "SKEL", member_->skel_offset - member_->member_offset,
+                "the bank's skeleton exceeds the limit of " + std::to_string(limits_.max_decompressed_bytes) + " bytes");
   for (uint32_t i = 0; i < section_count; ++i) {
     const TableEntry& e = table_[i];
     const bool known = e.tag == internal::kTagNote || !(e.flags & internal::kSectionAncillary);
@@ -150,6 +160,24 @@ Status Loader::read_header_and_table() {
   const uint32_t stored_crc = internal::load_le<uint32_t>(p + pos);
   if (static_cast<uint32_t>(crc) != stored_crc)
     return fail(Status::checksum_mismatch, "checksum", pos, "CRC-32 of the file does not match its checksum");
+  return Status::ok;
+}
+
+Status Loader::check_header_flags(uint16_t major, uint32_t flags) {
+  const uint32_t known =
+      major >= internal::kRuntimeVersionMajor ? internal::kHeaderRuntime | internal::kHeaderMember | internal::kHeaderBank : 0u;
+  if (flags & internal::kHeaderReservedMask & ~known)
+    return fail(Status::reserved_bits_set, "header", 12, "reserved Header_Flags bits are set");
+  const bool member = (flags & internal::kHeaderMember) != 0;
+  if (member_ == nullptr && (flags & internal::kHeaderBank))
+    return fail(Status::invalid_argument, "header", 12,
+                "a bank of many clips (spec section 10), not a clip: open it with keyanim::Bank");
+  if (member_ == nullptr && member)
+    return fail(Status::corrupt, "header", 12, "a bank's member (Header_Flags bit 1), which only its bank reads");
+  if (member_ != nullptr && (!member || (flags & internal::kHeaderBank)))
+    return fail(Status::corrupt, "header", 12, "a bank's clip must have Header_Flags bit 1 (Member) set and bit 2 (Bank) clear");
+  if (member_ != nullptr && runtime_ != member_->runtime)
+    return fail(Status::corrupt, "header", 12, "a bank's clips are of the bank's profile (Header_Flags bit 0)");
   return Status::ok;
 }
 
@@ -207,12 +235,24 @@ Status Loader::get_content(const TableEntry& e, const char* name, Content& out, 
   }
   buffers_.emplace_back(new uint8_t[static_cast<size_t>(e.raw) + 1]);  // +1: valid when raw is 0
   uint8_t* buf = buffers_.back().get();
-  const size_t got = ZSTD_decompressDCtx(dctx_.get(), buf, static_cast<size_t>(e.raw), src, stored);
+  const ZSTD_DDict* dict = member_ != nullptr ? member_->dictionary : nullptr;  // section 10.4
+  const size_t got = dict != nullptr ? ZSTD_decompress_usingDDict(dctx_.get(), buf, static_cast<size_t>(e.raw), src, stored, dict)
+                                     : ZSTD_decompressDCtx(dctx_.get(), buf, static_cast<size_t>(e.raw), src, stored);
   if (ZSTD_isError(got))
     return fail(Status::zstd_error, name, e.file_offset, std::string("zstd: ") + ZSTD_getErrorName(got));
   if (got != e.raw) return fail(Status::zstd_error, name, e.file_offset, "the zstd frame decompressed to the wrong size");
   out.data = buf;
   out.size = got;
+  return Status::ok;
+}
+
+Status Loader::get_skel(int index, Content& out) {
+  if (member_ == nullptr) return get_content(table_[static_cast<size_t>(index)], "SKEL", out);
+  out.name = "SKEL";
+  out.data = member_->skel.data();
+  out.size = member_->skel.size();
+  out.file_offset = member_->skel_offset - member_->member_offset;  // wraps: fail() adds it back
+  out.compressed = member_->skel_compressed;
   return Status::ok;
 }
 

@@ -1,0 +1,192 @@
+// keyanim::Bank: a bank's bytes (owned, mapped or the caller's), its checked index, the
+// dictionary ready for zstd, and one rig cache, so that clips of one skeleton share a rig.
+#include "keyanim/bank.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zstd.h>
+
+#include <cstring>
+#include <new>
+#include <vector>
+
+#include "runtime/bank/bank_index.h"
+#include "runtime/load/member.h"
+
+namespace keyanim {
+
+struct DDictDeleter {
+  void operator()(ZSTD_DDict* d) const noexcept { ZSTD_freeDDict(d); }
+};
+
+struct Bank::State {
+  std::shared_ptr<const void> storage;  // owns the bytes (a copy or a mapping); null: the caller does
+  internal::BankIndex index;
+  std::unique_ptr<ZSTD_DDict, DDictDeleter> dictionary;
+  std::vector<std::vector<uint8_t>> skeletons;  // each one's content, inflated once at open
+  mutable RigCache rigs;  // thread-safe
+};
+
+Bank::Bank() = default;
+Bank::~Bank() = default;
+Bank::Bank(const Bank&) = default;
+Bank& Bank::operator=(const Bank&) = default;
+Bank::Bank(Bank&&) noexcept = default;
+Bank& Bank::operator=(Bank&&) noexcept = default;
+
+namespace {
+
+Status out_of_memory(ErrorInfo* err) {
+  if (err != nullptr) *err = ErrorInfo{Status::limit_exceeded, 0, "bank", "out of memory"};
+  return Status::limit_exceeded;
+}
+
+// A read-only mapping of a whole file, unmapped with its last user.
+struct Mapping {
+  void* at = nullptr;
+  size_t size = 0;
+  ~Mapping() {
+    if (at != nullptr) ::munmap(at, size);
+  }
+};
+
+}  // namespace
+
+Status Bank::make(std::span<const uint8_t> bytes, std::shared_ptr<const void> storage, Bank& out, ErrorInfo* err) {
+  auto state = std::make_shared<State>();
+  if (Status s = internal::check_bank_index(bytes, state->index, err); s != Status::ok) return s;
+  const std::span<const uint8_t> dict = state->index.dictionary();
+  if (!dict.empty()) {
+    // Digested once for all the bank's clips (zstd's stable API copies it).
+    state->dictionary.reset(ZSTD_createDDict(dict.data(), dict.size()));
+    if (!state->dictionary) return out_of_memory(err);
+  }
+  uint64_t limit = DecodeLimits{}.max_decompressed_bytes;  // what all skeletons may inflate to
+  state->skeletons.resize(state->index.skeletons);           // bounded: the table fits in the bank
+  for (uint32_t k = 0; k < state->index.skeletons; ++k)
+    if (Status s = internal::skeleton_content(state->index, k, limit, state->skeletons[k], err); s != Status::ok) return s;
+  state->storage = std::move(storage);
+  out.state_ = std::move(state);
+  return Status::ok;
+}
+
+Status Bank::view(std::span<const uint8_t> bytes, Bank& out, ErrorInfo* err) {
+  out = Bank{};
+  if (reinterpret_cast<uintptr_t>(bytes.data()) % 8 != 0) {
+    if (err != nullptr) *err = ErrorInfo{Status::invalid_argument, 0, "bank", "Bank::view needs the bytes at an address that is a multiple of 8"};
+    return Status::invalid_argument;
+  }
+  try {
+    return make(bytes, nullptr, out, err);
+  } catch (const std::bad_alloc&) {
+    return out_of_memory(err);
+  }
+}
+
+Status Bank::open(std::span<const uint8_t> bytes, Bank& out, ErrorInfo* err) {
+  out = Bank{};
+  try {
+    auto words = std::shared_ptr<uint64_t[]>(new uint64_t[(bytes.size() + 7) / 8]);  // 8-aligned
+    if (!bytes.empty()) std::memcpy(words.get(), bytes.data(), bytes.size());
+    const std::span<const uint8_t> copy(reinterpret_cast<const uint8_t*>(words.get()), bytes.size());
+    return make(copy, std::move(words), out, err);
+  } catch (const std::bad_alloc&) {
+    return out_of_memory(err);
+  }
+}
+
+Status Bank::open_file(const std::string& path, Bank& out, ErrorInfo* err) {
+  out = Bank{};
+  auto io_fail = [&](const char* what) {
+    if (err != nullptr) *err = ErrorInfo{Status::io_error, 0, "file", path + ": " + what + ": " + std::strerror(errno)};
+    return Status::io_error;
+  };
+  // O_NONBLOCK: a FIFO's open would wait for a writer; it is then refused as not a regular
+  // file (the flag changes nothing for a regular file, which is mapped, not read).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return io_fail("cannot open");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    errno = errno == 0 ? EINVAL : errno;
+    return io_fail("not a regular file");
+  }
+  try {
+    auto map = std::make_shared<Mapping>();
+    map->size = static_cast<size_t>(st.st_size);
+    if (map->size > 0) {
+      void* at = ::mmap(nullptr, map->size, PROT_READ, MAP_PRIVATE, fd, 0);
+      if (at == MAP_FAILED) {
+        ::close(fd);
+        return io_fail("cannot map");
+      }
+      map->at = at;
+    }
+    ::close(fd);
+    const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(map->at), map->size);  // page-aligned
+    return make(bytes, std::move(map), out, err);
+  } catch (const std::bad_alloc&) {
+    ::close(fd);
+    return out_of_memory(err);
+  }
+}
+
+uint32_t Bank::clip_count() const noexcept { return state_ ? state_->index.clips : 0; }
+uint32_t Bank::skeleton_count() const noexcept { return state_ ? state_->index.skeletons : 0; }
+bool Bank::runtime_profile() const noexcept { return state_ && state_->index.runtime; }
+uint64_t Bank::dictionary_bytes() const noexcept { return state_ ? state_->index.dictionary().size() : 0; }
+uint64_t Bank::size_bytes() const noexcept { return state_ ? state_->index.bytes.size() : 0; }
+BankEntry Bank::entry(uint32_t i) const { return state_->index.entry(i); }
+
+std::optional<uint32_t> Bank::find(std::string_view name) const noexcept {
+  if (!state_) return std::nullopt;
+  const internal::BankIndex& idx = state_->index;
+  uint32_t lo = 0, hi = idx.clips;  // the name order is strictly increasing (checked at open)
+  while (lo < hi) {
+    const uint32_t mid = lo + (hi - lo) / 2;
+    const uint32_t i = idx.order(mid);
+    const std::string_view n = idx.name(idx.clip_at(i));
+    if (n == name) return i;
+    if (n < name) lo = mid + 1;
+    else hi = mid;
+  }
+  return std::nullopt;
+}
+
+Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& limits) const {
+  out = Clip{};
+  if (err != nullptr) *err = ErrorInfo{};
+  if (!state_ || i >= state_->index.clips) {
+    if (err != nullptr) *err = ErrorInfo{Status::invalid_argument, 0, "bank", "no clip " + std::to_string(i) + " in the bank"};
+    return Status::invalid_argument;
+  }
+  const internal::BankIndex& idx = state_->index;
+  const BankEntry e = idx.entry(i);
+  internal::MemberContext m;
+  m.skel = state_->skeletons[e.skeleton];
+  m.skel_offset = idx.skeleton(e.skeleton).offset;
+  m.skel_compressed = idx.skeleton(e.skeleton).compressed;
+  m.member_offset = e.offset;
+  m.dictionary = state_->dictionary.get();
+  m.runtime = idx.runtime;
+  // The clip keeps the bank's state (and so its bytes and dictionary) alive.
+  Status s = internal::check_member_padding(idx, i, err);
+  if (s == Status::ok)
+    s = internal::load_member(idx.bytes.subspan(e.offset, e.size), m, state_->storage ? state_ : nullptr, limits,
+                                   &state_->rigs, out, err);
+  const double frame_time = out.frame_time();
+  if (s == Status::ok &&
+      (out.frame_count() != e.frame_count || std::memcmp(&e.frame_time, &frame_time, sizeof(double)) != 0)) {
+    if (err != nullptr)
+      *err = ErrorInfo{Status::corrupt, idx.layout.clip_table + uint64_t(i) * internal::kBankClipEntrySize + 16, "clip table",
+                       "Frame_Count or Frame_Time differs from the clip's CLIP"};
+    out = Clip{};
+    s = Status::corrupt;
+  }
+  if (s != Status::ok && err != nullptr) err->section = "clip " + std::string(e.name) + " (" + std::to_string(i) + "), " + err->section;
+  return s;
+}
+
+}  // namespace keyanim

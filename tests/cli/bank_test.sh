@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Banks through the real binary (spec/FORMAT.md section 10): pack, list, unpack, LIB:NAME read
+# by every command that reads a .kanim, and the refusals. Values are checked against the clips'
+# own files, which keyanim encode writes independently of the bank.
+# bank_test.sh KEYANIM DATA_DIR CASE; each case exits non-zero on the first surprise.
+set -uo pipefail
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh" "$@"
+json() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
+mkdir -p lib/cmu
+cp "$WALK" lib/cmu/walk.bvh
+cp "$HOP" lib/hop.bvh
+
+case "$CASE" in
+pack)
+  expect_rc 0 "$K" pack lib -o lib.kbank
+  "$K" list lib.kbank --json >l.json || die "list --json"
+  [ "$(json '[c["name"] for c in d["clips"]]' <l.json)" = "['cmu/walk', 'hop']" ] || die "names: $(cat l.json)"
+  [ "$(json 'd["skeletons"], d["profile"]' <l.json)" = "2 archive" ] || die "skeletons and profile: $(cat l.json)"
+  [ "$(json 'd["bytes"]' <l.json)" = "$(stat -c %s lib.kbank)" ] || die "list's bytes are not the file's size"
+  # Each clip as its own file: the same values and the same BVH as keyanim encode's file.
+  expect_rc 0 "$K" encode lib/cmu/walk.bvh -o walk.kanim
+  expect_rc 0 "$K" encode lib/hop.bvh -o hop.kanim
+  for pair in "cmu/walk walk" "hop hop"; do
+    set -- $pair
+    expect_rc 0 "$K" decode "lib.kbank:$1" -o "b_$2.bvh"
+    expect_rc 0 "$K" decode "$2.kanim" -o "f_$2.bvh"
+    cmp -s "b_$2.bvh" "f_$2.bvh" || die "lib.kbank:$1 decodes to another BVH than $2.kanim"
+    a=$("$K" sample "lib.kbank:$1" --frame 17.5 --json | json 'd["joints"]') || die "sample lib.kbank:$1"
+    b=$("$K" sample "$2.kanim" --frame 17.5 --json | json 'd["joints"]') || die "sample $2.kanim"
+    [ "$a" = "$b" ] || die "sample of lib.kbank:$1 differs from $2.kanim"
+  done
+  expect_rc 0 "$K" verify lib.kbank:cmu/walk --against "$WALK" --max-error 0.05%
+  [ "$("$K" info lib.kbank:hop --json | json 'd["frames"]')" = 1102 ] || die "info of a bank's clip"
+  expect_rc 0 "$K" view lib.kbank:hop -o hop.html --no-open
+  [ -s hop.html ] || die "view of a bank's clip wrote nothing"
+  # Default output names: beside the bank, after the clip's name.
+  expect_rc 0 "$K" decode lib.kbank:cmu/walk
+  [ -f walk.bvh ] || die "decode LIB:cmu/walk did not write walk.bvh beside the bank"
+  # A runtime bank, and merging banks, .kanim files and BVH.
+  expect_rc 0 "$K" pack lib -o r.kbank --runtime
+  [ "$("$K" list r.kbank --json | json 'd["profile"]')" = runtime ] || die "pack --runtime"
+  a=$("$K" sample r.kbank:hop --frame 99 --json | json 'd["joints"]') && b=$("$K" sample hop.kanim --frame 99 --json | json 'd["joints"]')
+  [ "$a" = "$b" ] || die "the runtime bank's clip samples otherwise"
+  expect_rc 0 "$K" pack r.kbank walk.kanim "$WALK" -o merged.kbank --dictionary on
+  "$K" list merged.kbank --json >m.json
+  [ "$(json 'sorted(c["name"] for c in d["clips"])' <m.json)" = "['cmu/walk', 'cmu_02_01_walk', 'hop', 'walk']" ] || die "merged names: $(cat m.json)"
+  [ "$(json 'd["skeletons"], d["dictionary_bytes"] > 0' <m.json)" = "2 True" ] || die "merged: $(cat m.json)"
+  printf 'lib/hop.bvh\nlib/cmu/walk.bvh\n' >list.txt
+  expect_rc 0 "$K" pack --manifest list.txt -o m2.kbank
+  [ "$("$K" list m2.kbank --json | json '[c["name"] for c in d["clips"]]')" = "['lib/hop', 'lib/cmu/walk']" ] || die "manifest names"
+  ;;
+unpack)
+  expect_rc 0 "$K" pack lib -o lib.kbank
+  expect_rc 0 "$K" unpack lib.kbank -o out
+  [ -f out/cmu/walk.kanim ] && [ -f out/hop.kanim ] || die "unpack wrote: $(find out)"
+  expect_rc 0 "$K" decode out/cmu/walk.kanim -o u.bvh
+  expect_rc 0 "$K" decode lib.kbank:cmu/walk -o b.bvh
+  cmp -s u.bvh b.bvh || die "the unpacked clip decodes otherwise"
+  expect_rc 4 "$K" unpack lib.kbank -o out  # exists: not without -f
+  expect_rc 0 "$K" -f unpack lib.kbank -o out --runtime
+  [ "$("$K" info out/hop.kanim --json | json 'd["profile"]')" = runtime ] || die "unpack --runtime"
+  ;;
+refusals)
+  expect_rc 0 "$K" pack lib -o lib.kbank
+  expect_rc 2 "$K" decode lib.kbank -o x.bvh
+  grep -q 'a bank of many clips: name one as lib.kbank:NAME' .stderr || die "a bank without :NAME: $(cat .stderr)"
+  expect_rc 2 "$K" sample lib.kbank:nope --frame 0
+  grep -q "no clip named 'nope'" .stderr || die "an unknown clip: $(cat .stderr)"
+  expect_rc 2 "$K" list walk.bvh 2>/dev/null || true
+  expect_rc 0 "$K" encode "$WALK" -o walk.kanim
+  expect_rc 2 "$K" list walk.kanim
+  grep -q 'not a bank' .stderr || die "list of a .kanim: $(cat .stderr)"
+  expect_rc 4 "$K" pack lib -o lib.kbank  # exists
+  expect_rc 1 "$K" pack lib -o lib.kanim  # a bank's name says .kbank
+  expect_rc 4 "$K" -f pack lib.kbank -o lib.kbank  # an input is never the output
+  # Two clips of one name: refused before anything is encoded, nothing written.
+  cp "$WALK" lib/hop.BVH 2>/dev/null; mkdir -p other && cp "$HOP" other/hop.bvh
+  expect_rc 2 "$K" pack lib/hop.bvh other/hop.bvh -o two.kbank
+  grep -q "would be named 'hop'" .stderr || die "two clips of one name: $(cat .stderr)"
+  [ ! -e two.kbank ] || die "a refused pack left its output"
+  # A damaged clip: named; the others still read; unpack writes the others and exits 2.
+  python3 - lib.kbank <<'PY'
+import struct, sys
+b = bytearray(open(sys.argv[1], 'rb').read())
+clips, skels = struct.unpack_from('<II', b, 16)
+off, size = struct.unpack_from('<QQ', b, 40 + 32 * skels + 40 * 0)  # clip 0: cmu/walk
+b[off + size - 20] ^= 0x40
+open('bad.kbank', 'wb').write(b)
+PY
+  expect_rc 2 "$K" sample bad.kbank:cmu/walk --frame 0
+  grep -q 'clip cmu/walk' .stderr && grep -q checksum_mismatch .stderr || die "a damaged clip: $(cat .stderr)"
+  expect_rc 0 "$K" sample bad.kbank:hop --frame 0
+  expect_rc 0 "$K" list bad.kbank
+  expect_rc 2 "$K" unpack bad.kbank -o part
+  [ -f part/hop.kanim ] && [ ! -e part/cmu/walk.kanim ] || die "unpack of a damaged bank wrote: $(find part)"
+  # A damaged index: refused with its place.
+  python3 -c "import sys; b=bytearray(open('lib.kbank','rb').read()); b[50]^=1; open('badi.kbank','wb').write(b)"
+  expect_rc 2 "$K" list badi.kbank
+  grep -q 'badi.kbank: section skeleton table, offset 48' .stderr || die "a damaged index: $(cat .stderr)"
+  ;;
+*) die "unknown case $CASE" ;;
+esac
