@@ -2,7 +2,8 @@
 
 The banks are made here by BankWriter, a small writer written from section 10's text (a test
 helper, not shipped): it turns the existing test vectors into members (SKEL taken out, into
-the bank's skeleton table, each distinct skeleton once; Major_Version 4 and the Member bit set;
+the bank's skeletons, each distinct skeleton once, stored as the vector stored it, zstd or not;
+Major_Version 4 and the Member bit set;
 the member's own checksum recomputed) and lays out header, tables, name order, names,
 dictionary, skeletons, Bank_Checksum and members as 10.1 says. Every clip must decode to the
 keys and the expected values (.json) of the standalone vector it came from; then one rule of
@@ -91,16 +92,18 @@ def as_member(data, dictionary=None, minor=1, keep_skel=False):
 
 
 def as_member_uncached(data, dictionary=None, minor=1, keep_skel=False):
-    """(member bytes, SKEL content, CLIP's Frame_Time, CLIP's Frame_Count) of clip file `data`
+    """(member bytes, skeleton, CLIP's Frame_Time, CLIP's Frame_Count) of clip file `data`
     (10.5): version 4.`minor`, Member set, no SKEL (kept, to break 10.5.2, with keep_skel),
-    compressed sections recompressed with the bank's dictionary (a file) when there is one."""
+    compressed sections recompressed with the bank's dictionary (a file) when there is one.
+    skeleton: {raw: SKEL's content, stored: its bytes in the file, flags: Compressed or 0},
+    stored in the bank as the file stores it (a zstd frame made without any dictionary)."""
     flags = struct.unpack_from("<I", data, 12)[0]
     runtime = bool(flags & RUNTIME)
     entries, skel = [], None
     for tag, sflags, stored, raw, body in table_of(data):
         plain = zstd(["-d"], body) if sflags & 1 else body
         if tag == b"SKEL":
-            skel = plain  # the skeleton table holds SKEL's content uncompressed (10.3)
+            skel = {"raw": plain, "stored": body, "flags": sflags & 1}
             if not keep_skel:
                 continue
         elif sflags & 1 and dictionary is not None:
@@ -125,10 +128,12 @@ class BankWriter:
 
     def add(self, name, data, **member_args):
         member, skel, frame_time, frame_count = as_member(data, dictionary=self.dict_path(), **member_args)
-        if skel not in self.skeletons:
-            self.skeletons.append(skel)
+        raws = [x["raw"] for x in self.skeletons]
+        if skel["raw"] not in raws:  # each distinct skeleton (its content) once
+            self.skeletons.append(dict(skel))
+            raws.append(skel["raw"])
         self.clips.append({"name": name, "member": member, "frame_time": frame_time,
-                           "frame_count": frame_count, "skeleton": self.skeletons.index(skel)})
+                           "frame_count": frame_count, "skeleton": raws.index(skel["raw"])})
         return self
 
     def dict_path(self):
@@ -152,7 +157,7 @@ class BankWriter:
             order = sorted(range(len(names)), key=lambda i: names[i])
         dictionary = self.dictionary or b""
         n_clips, n_skel = len(self.clips), len(self.skeletons)
-        self.at = {"clip_table": 40 + 16 * n_skel, "order": 40 + 16 * n_skel + 40 * n_clips}
+        self.at = {"clip_table": 40 + 32 * n_skel, "order": 40 + 32 * n_skel + 40 * n_clips}
         self.at["names"] = self.at["order"] + 4 * n_clips
         pos = self.at["names"] + len(pool)
         self.at["dictionary"] = pad8(pos)
@@ -160,7 +165,7 @@ class BankWriter:
         skel_at = []
         for s in self.skeletons:
             skel_at.append(pad8(pos))
-            pos = skel_at[-1] + len(s)
+            pos = skel_at[-1] + len(s["stored"])
         self.at["checksum"] = pad8(pos)
         pos = self.at["checksum"] + 8
         member_at = []
@@ -173,11 +178,12 @@ class BankWriter:
             n_clips if clip_count is None else clip_count, n_skel if skeleton_count is None else skeleton_count,
             len(pool) if names_size is None else names_size, len(dictionary) if dictionary_size is None else dictionary_size)
         out = bytearray(header)
-        out += b"".join(struct.pack("<QQ", skel_at[j], len(s)) for j, s in enumerate(self.skeletons))
+        out += b"".join(struct.pack("<QQQII", skel_at[j], len(s["stored"]), s.get("raw_size", len(s["raw"])), s["flags"], 0)
+                        for j, s in enumerate(self.skeletons))
         out += b"".join(struct.pack("<QQdIIII", member_at[i], len(c["member"]), c["frame_time"], c["frame_count"],
                                     c["skeleton"], name_at[i], len(c["name"])) for i, c in enumerate(self.clips))
         out += struct.pack(f"<{len(order)}I", *order) + pool
-        for at, part in [(self.at["dictionary"], dictionary)] + list(zip(skel_at, self.skeletons)):
+        for at, part in [(self.at["dictionary"], dictionary)] + list(zip(skel_at, [x["stored"] for x in self.skeletons])):
             out += bytes(at - len(out)) + part
         out += bytes(self.at["checksum"] - len(out))
         out += struct.pack("<Q", rd.xxh64(bytes(out)))
@@ -193,6 +199,9 @@ class BankWriter:
 
     def entry(self, i):
         return self.at["clip_table"] + 40 * i
+
+    def skeleton_entry(self, j):
+        return 40 + 32 * j
 
 
 # ---- The banks of the tests
@@ -302,6 +311,7 @@ def test_an_archive_bank_decodes_each_clip_as_its_standalone_vector(archive):
     w, data = archive
     bank = check_bank_decodes(w, data, ARCHIVE_CLIPS)
     assert not bank["runtime"] and bank["dictionary"] is None
+    assert [s["flags"] for s in bank["skeletons"]] == [1, 0, 1, 1, 0, 1]  # zstd and plain skeletons
     # two skeletons fewer than clips: v3_rules' is shared by three clips
     assert len(bank["skeletons"]) == len(ARCHIVE_CLIPS) - 2
     assert [c["skeleton"] for c in bank["clips"]][:3] == [0, 1, 0]
@@ -467,7 +477,8 @@ OPEN_RULES = {
     "Names_Size 2^64-1": (patch("Q", lambda w: 24, 2 ** 64 - 1), "truncated", "Names_Size 18446744073709551615"),
     "Dictionary_Size past the end": (patch("Q", lambda w: 32, 2 ** 40), "corrupt", "skeleton table entry 0: Offset"),
     "a skeleton Offset 8 later": (patch("Q", lambda w: 40, lambda w, old: old + 8), "corrupt", "skeleton table entry 0: Offset"),
-    "a skeleton of Size 0": (rebuilt(lambda w: w.skeletons.__setitem__(1, b"")), "corrupt", "skeleton table entry 1: Size 0"),
+    "a skeleton of Stored_Size 0": (rebuilt(lambda w: w.skeletons.__setitem__(1, {"raw": b"", "stored": b"", "flags": 0})),
+                                    "corrupt", "skeleton table entry 1: Stored_Size 0"),
     "a clip Offset outside the file": (patch("Q", clip_field(2, 0), lambda w, old: old + 2 ** 20), "corrupt",
                                        "clip table entry 2: Offset"),
     "two clips overlapping": (patch("Q", clip_field(3, 0), lambda w, old: w.at["members"][2]), "corrupt",
@@ -478,7 +489,20 @@ OPEN_RULES = {
     "a byte less": (lambda w, d: d[:-1], "truncated", "the last part ends"),
     "padding before the dictionary": (patch("B", lambda w: w.at["dictionary"] - 1, 1), "corrupt", "padding bytes"),
     "padding before the checksum": (patch("B", lambda w: w.at["checksum"] - 1, 1), "corrupt", "padding bytes"),
-    "padding between members": (patch("B", lambda w: w.at["members"][1] - 1, 1, refix=False), "corrupt", "padding bytes"),
+    # 10.3: the skeleton table (skeleton 0 is v3_rules' SKEL, zstd; 1 v3_uniform's, uncompressed)
+    "Skeleton_Flags bit 1": (patch("I", lambda w: w.skeleton_entry(0) + 24, lambda w, old: old | 2), "reserved_bits_set",
+                             "Skeleton_Flags bits 1-15"),
+    "Skeleton_Reserved": (patch("I", lambda w: w.skeleton_entry(1) + 28, 1), "reserved_bits_set", "Skeleton_Reserved"),
+    "Raw_Size 0": (patch("Q", lambda w: w.skeleton_entry(0) + 16, 0), "corrupt", "skeleton table entry 0: Raw_Size 0"),
+    "an uncompressed skeleton's Raw_Size": (patch("Q", lambda w: w.skeleton_entry(1) + 16, lambda w, old: old + 1), "corrupt",
+                                            "not Compressed, Raw_Size"),
+    "Raw_Size past 32768 x Stored_Size": (patch("Q", lambda w: w.skeleton_entry(0) + 16,
+                                                lambda w, old: 32768 * len(w.skeletons[0]["stored"]) + 1),
+                                          "zstd_error", "> 32768 x Stored_Size"),
+    "a frame declaring another Raw_Size": (patch("Q", lambda w: w.skeleton_entry(0) + 16, lambda w, old: old + 1),
+                                           "zstd_error", "skeleton 0 (bytes"),
+    "Compressed on bytes that are no zstd frame": (patch("I", lambda w: w.skeleton_entry(1) + 24, 1), "zstd_error",
+                                                   "skeleton 1 (bytes"),
     # 10.3: the clip table
     "Skeleton = Skeleton_Count": (patch("I", clip_field(0, 28), lambda w, old: len(w.skeletons)), "corrupt",
                                   "Skeleton 6 >= Skeleton_Count 6"),
@@ -519,6 +543,45 @@ def test_a_broken_bank_rule_is_refused_when_the_bank_opens(case, archive):
     assert e.value.status == status, str(e.value)
     assert message in str(e.value), str(e.value)
     assert e.value.clip is None and e.value.offset is not None
+
+
+def test_padding_before_a_member_refuses_that_member_only(archive):
+    """10.1, 10.5: the padding before a member is checked when the member is opened."""
+    w = make_bank(ARCHIVE_CLIPS)
+    data = w.build()
+    ends = [at + len(c["member"]) for at, c in zip(w.at["members"], w.clips)]
+    i = next(i for i in range(1, len(ends)) if w.at["members"][i] > ends[i - 1])
+    b = bytearray(data)
+    b[w.at["members"][i] - 1] = 1
+    check_member_refused(w, bytes(b), i, "corrupt", "the padding before its member")
+
+
+def test_a_skeleton_made_with_the_dictionary_is_refused(dictionary_bank):
+    """10.3: a compressed skeleton is a frame made without the bank's dictionary."""
+    w0, _ = dictionary_bank
+    w = BankWriter(dictionary=w0.dictionary)
+    w.clips, w.skeletons = w0.clips, [dict(x) for x in w0.skeletons]
+    w.skeletons[0].update(stored=zstd(["-19", "-D", w.dict_path()], w.skeletons[0]["raw"]), flags=1)
+    with pytest.raises(rd.KanimError) as e:
+        rd.open_bank(w.build())
+    assert e.value.status == "zstd_error" and "skeleton 0" in str(e.value), str(e.value)
+
+
+def test_the_skeletons_raw_size_sum_is_held_to_the_limit_before_inflating():
+    """10.3: the sum of Raw_Size against the decoder's limit of decompressed bytes (1 GiB here,
+    keyanim's), each within 32768 x Stored_Size; refused without inflating (peak memory)."""
+    w = BankWriter()
+    w.skeletons = [{"raw": b"", "raw_size": 32768 * 33000, "stored": bytes(33000), "flags": 1}]
+    data = w.build()
+    tracemalloc.start()
+    try:
+        with pytest.raises(rd.KanimError) as e:
+            rd.open_bank(data)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert e.value.status == "limit_exceeded" and "Raw_Size sum 1081344000" in str(e.value), str(e.value)
+    assert peak < 64 * 1024, peak
 
 
 def test_a_bad_dictionary_magic_is_refused(dictionary_bank):
@@ -656,8 +719,8 @@ def check_member_refused(w, data, i, status, message, others_decode=True):
     assert message in str(e.value), str(e.value)
     assert e.value.clip == (i, name) and f"clip {i} {name.decode()!r}" in str(e.value)
     entry = (w.entry(i), w.entry(i) + 40)
-    member = (w.at["members"][i], w.at["members"][i] + len(w.clips[i]["member"]))
-    # (truncated: the place is the end of the member)
+    member = (w.at["members"][i] - 7, w.at["members"][i] + len(w.clips[i]["member"]))
+    # (the member's padding before it; truncated: the place is the end of the member)
     assert entry[0] <= e.value.offset < entry[1] or member[0] <= e.value.offset <= member[1], e.value.offset
     for j in range(len(w.clips) if others_decode else 0):  # the other clips still decode
         if j != i:
@@ -705,3 +768,66 @@ def test_a_damaged_runtime_member_is_refused_by_its_xxh64():
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+# ---- The same banks through keyanim (C++, written apart from this decoder), where KEYANIM_CLI
+# names the tool: it must read the writer's banks to the same clips, and refuse each broken
+# bank or member with the same status.
+
+def tool():
+    path = os.environ.get("KEYANIM_CLI")
+    if not path or not os.path.exists(path):
+        pytest.skip("the keyanim tool is not built (KEYANIM_CLI)")
+    return path
+
+
+def tool_status(args):
+    """(exit code, status name in keyanim's error line, stderr)."""
+    r = subprocess.run([tool(), *map(str, args)], capture_output=True, text=True, errors="surrogateescape")
+    found = [s for s in ["bad_signature", "truncated", "unsupported_version", "reserved_bits_set", "corrupt",
+                         "checksum_mismatch", "trailing_bytes", "limit_exceeded", "zstd_error"] if f": {s}: " in r.stderr]
+    if "(bad signature)" in r.stderr:  # keyanim words this one status as a sentence
+        found.append("bad_signature")
+    return r.returncode, found, r.stderr
+
+
+@pytest.mark.parametrize("kind", ["archive", "runtime", "dictionary"])
+def test_keyanim_unpacks_the_writers_banks_to_the_standalone_clips(kind, archive, runtime, dictionary_bank, tmp_path):
+    (w, data), clips = {"archive": (archive, ARCHIVE_CLIPS), "runtime": (runtime, RUNTIME_CLIPS),
+                        "dictionary": (dictionary_bank, {k: v for k, v in ARCHIVE_CLIPS.items() if k != b"blocks"})}[kind]
+    bank = tmp_path / "b.kbank"
+    bank.write_bytes(data)
+    code, _, err = tool_status(["-q", "unpack", bank, "-o", tmp_path / "out"])
+    assert code == 0, err
+    for name, (src, _) in clips.items():
+        compare_with_standalone(rd.parse((tmp_path / "out" / (name.decode() + ".kanim")).read_bytes()), src)
+
+
+# Files that break two rules, which section 7 lets a decoder report with either status.
+EITHER = {"Dictionary_Size past the end": {"corrupt", "truncated"}}  # offsets, and the file's end
+
+
+@pytest.mark.parametrize("case", list(OPEN_RULES))
+def test_keyanim_refuses_the_broken_bank_too(case, archive, tmp_path):
+    w = make_bank(ARCHIVE_CLIPS)
+    data = w.build()
+    make, status, _ = OPEN_RULES[case]
+    path = tmp_path / "b.kbank"
+    path.write_bytes(make(w, data))
+    code, found, err = tool_status(["list", path])
+    assert code != 0 and set(found) & EITHER.get(case, {status}), err
+
+
+@pytest.mark.parametrize("case", list(MEMBER_RULES))
+def test_keyanim_refuses_the_broken_member_too(case, tmp_path):
+    i, make, status, _ = MEMBER_RULES[case]
+    w, data = make()
+    path = tmp_path / "b.kbank"
+    path.write_bytes(data)
+    name = w.clips[i]["name"].decode()
+    code, found, err = tool_status(["convert", f"{path}:{name}", "--archive", "-o", tmp_path / "out.kanim"])
+    assert code != 0 and status in found and name in err, err
+    assert not (tmp_path / "out.kanim").exists()
+    other = w.clips[(i + 1) % len(w.clips)]["name"].decode()  # another clip of the bank still converts
+    code, _, err = tool_status(["-q", "convert", f"{path}:{other}", "--archive", "-o", tmp_path / "other.kanim"])
+    assert code == 0, err

@@ -359,11 +359,8 @@ for _name, (_make, _message) in PREDICT_LISTS.items():
 
 
 # Cases where keyanim (C++) is known to differ from this decoder (strict: the mark must go when
-# the tool changes).
-CPP_DIFFERS = {
-    "Header_Flags bit 1 (Member) by itself": "keyanim before banks (4.1) reads bit 1 as reserved (reserved_bits_set); "
-                                             "10.5.1 makes a file by itself with Member set corrupt",
-}
+# the tool changes). None today.
+CPP_DIFFERS = {}
 
 
 def cli_refuses(data, status, tmp_path):

@@ -867,9 +867,13 @@ def check_image_content(image):
 # Banks (section 10): many clips in one file, each distinct skeleton once, an index by position
 # and by name, a zstd dictionary for archive-profile members, a checksum per clip.
 
-BANK_HEADER_SIZE, SKELETON_ENTRY_SIZE, CLIP_ENTRY_SIZE, NAME_ORDER_ENTRY_SIZE = 40, 16, 40, 4
+BANK_HEADER_SIZE, SKELETON_ENTRY_SIZE, CLIP_ENTRY_SIZE, NAME_ORDER_ENTRY_SIZE = 40, 32, 40, 4
 DICTIONARY_MAGIC = bytes([0x37, 0xA4, 0x30, 0xEC])  # RFC 8878 section 5
 MAX_NAME_SIZE = 1024
+# The one limit of section 8 this decoder applies: 10.3 makes comparing the skeletons' Raw_Size
+# sum with it a MUST before any is inflated. keyanim's default for decompressed bytes, 1 GiB.
+DECOMPRESSED_LIMIT = 1 << 30
+ZSTD_MAX_RATIO = 32768  # section 8: no zstd frame makes more than 32768 bytes of each of its bytes
 
 
 def is_bank(data):
@@ -911,8 +915,12 @@ def bank_tables(data, h):
         raise KanimError("truncated", f"bank: the tables and names ({h['skeletons']} skeletons, {h['clips']} clips, "
                          f"Names_Size {h['names_size']}) end at byte {names_at + h['names_size']}, "
                          f"past the file's {len(data)} bytes", len(data))
-    skeletons = [dict(zip(["offset", "size"], struct.unpack_from("<QQ", data, skel_at + 16 * j)), entry=skel_at + 16 * j)
-                 for j in range(h["skeletons"])]
+    skeletons = []
+    for j in range(h["skeletons"]):
+        at = skel_at + SKELETON_ENTRY_SIZE * j
+        offset, stored, raw, flags, reserved = struct.unpack_from("<QQQII", data, at)
+        skeletons.append({"index": j, "offset": offset, "stored": stored, "raw": raw, "flags": flags,
+                          "reserved": reserved, "entry": at})
     clips = []
     for i in range(h["clips"]):
         at = clip_at + CLIP_ENTRY_SIZE * i
@@ -927,7 +935,8 @@ def bank_tables(data, h):
 def bank_layout(data, h, skeletons, clips, names_at):
     """10.1: every part's offset computed from the sizes before it, the tables' Offset fields
     against it, the file's size against the end of the last part. Returns (the checksum's
-    offset, [(start, end) of every padding])."""
+    offset, [(start, end) of each padding before the checksum]): that padding is checked when the
+    bank opens, the padding before a member (c["padding"]) with the member (10.1)."""
     padding = []
 
     def align(pos):
@@ -939,13 +948,14 @@ def bank_layout(data, h, skeletons, clips, names_at):
         at = align(pos)
         if s["offset"] != at:
             raise KanimError("corrupt", f"skeleton table entry {j}: Offset {s['offset']}, the layout puts skeleton {j} at {at} (10.1)", s["entry"])
-        if s["size"] < 1:
-            raise KanimError("corrupt", f"skeleton table entry {j}: Size 0 (10.3)", s["entry"] + 8)
-        pos = at + s["size"]
+        if s["stored"] < 1:
+            raise KanimError("corrupt", f"skeleton table entry {j}: Stored_Size 0 (10.3)", s["entry"] + 8)
+        pos = at + s["stored"]
     checksum_at = align(pos)
     pos = checksum_at + 8
     for c in clips:
         at = align(pos)
+        c["padding"] = padding.pop()
         if c["offset"] != at:
             raise KanimError("corrupt", f"clip table entry {c['index']}: Offset {c['offset']}, the layout puts member "
                              f"{c['index']} at {at} (10.1)", c["entry"])
@@ -955,6 +965,49 @@ def bank_layout(data, h, skeletons, clips, names_at):
     if len(data) > pos:
         raise KanimError("trailing_bytes", f"bank: {len(data) - pos} bytes after the last part", pos)
     return checksum_at, padding
+
+
+def check_skeleton_entries(skeletons):
+    """The skeleton table's fields (10.3) that need no more than the table: flags, Raw_Size,
+    and a compressed one's Raw_Size within 32768 times its Stored_Size (section 8); then the
+    sum of Raw_Size against the limit, before anything is inflated."""
+    for s in skeletons:
+        j, at = s["index"], s["entry"]
+        if s["flags"] & 0xFFFE:
+            raise KanimError("reserved_bits_set", f"skeleton table entry {j}: Skeleton_Flags bits 1-15", at + 24)
+        if s["reserved"]:
+            raise KanimError("reserved_bits_set", f"skeleton table entry {j}: Skeleton_Reserved", at + 28)
+        if s["raw"] < 1:
+            raise KanimError("corrupt", f"skeleton table entry {j}: Raw_Size 0 (10.3)", at + 16)
+        if not s["flags"] & 1 and s["raw"] != s["stored"]:
+            raise KanimError("corrupt", f"skeleton table entry {j}: not Compressed, Raw_Size {s['raw']} != "
+                             f"Stored_Size {s['stored']} (3.2.4)", at + 16)
+        if s["flags"] & 1 and s["raw"] > ZSTD_MAX_RATIO * s["stored"]:
+            raise KanimError("zstd_error", f"skeleton table entry {j}: Raw_Size {s['raw']} > 32768 x Stored_Size "
+                             f"{s['stored']} (section 8)", at + 16)
+    total = sum(s["raw"] for s in skeletons)
+    if total > DECOMPRESSED_LIMIT:
+        raise KanimError("limit_exceeded", f"skeleton table: the skeletons' Raw_Size sum {total} > the limit "
+                         f"{DECOMPRESSED_LIMIT} (10.3, section 8)", BANK_HEADER_SIZE)
+
+
+def skeleton_content(data, s):
+    """A skeleton's content (10.3): its stored bytes, or the one zstd frame they hold (made
+    without the bank's dictionary) declaring and inflating to Raw_Size bytes."""
+    stored = data[s["offset"]:s["offset"] + s["stored"]]
+    if not s["flags"] & 1:
+        return stored
+    where = f"skeleton {s['index']} (bytes {s['offset']} to {s['offset'] + s['stored'] - 1})"
+    try:
+        declared = zstd_declared_size(stored)
+        if declared != s["raw"]:
+            raise KanimError("zstd_error", f"its frame declares {declared} bytes, not Raw_Size {s['raw']}")
+        content = zstd_decompress(stored)
+        if len(content) != s["raw"]:
+            raise KanimError("zstd_error", f"it inflates to {len(content)} bytes, not Raw_Size {s['raw']}")
+    except KanimError as e:
+        raise KanimError("zstd_error", f"{where}: {e.message}", s["offset"]) from e
+    return content
 
 
 def check_clip_entries(clips, h):
@@ -999,12 +1052,14 @@ def check_name_order(order, clips, order_at):
 
 def open_bank(data):
     """Opens a bank (10.1-10.4) from its index, reading no member: header, tables, layout and
-    file size, then Bank_Checksum, then padding, dictionary magic, names and their order.
+    file size, the tables' fields, the skeletons' size limit, then Bank_Checksum, then the
+    padding before it, dictionary magic, names and their order, and the skeletons inflated.
     Returns {data, runtime, version, dictionary, skeletons, clips, order}; clips[i] holds
     index, name (bytes), frame_count, frame_time, skeleton, offset and size."""
     h = bank_header(data)
     skeletons, clips, order, order_at, names_at = bank_tables(data, h)
     checksum_at, padding = bank_layout(data, h, skeletons, clips, names_at)
+    check_skeleton_entries(skeletons)
     check_clip_entries(clips, h)
     if xxh64(data[:checksum_at]) != struct.unpack_from("<Q", data, checksum_at)[0]:
         raise KanimError("checksum_mismatch", "Bank_Checksum (XXH64 of the bank's bytes before it)", checksum_at)
@@ -1022,6 +1077,8 @@ def open_bank(data):
         c["name"] = data[at:at + c["name_size"]]
         check_name(c["name"], c["index"], at)
     check_name_order(order, clips, order_at)
+    for s in skeletons:
+        s["content"] = skeleton_content(data, s)  # inflated once for all the clips of the skeleton
     return {"data": data, "runtime": h["runtime"], "version": (4, h["minor"]), "dictionary": dictionary,
             "skeletons": skeletons, "clips": clips, "order": order}
 
@@ -1048,13 +1105,17 @@ def clip_label(c):
 
 
 def decode_member(bank, i, check_content=True):
-    """Member i (10.5), in the dict parse returns: the checks of section 7 (and 9.4) on the
-    member's bytes with the bank's skeleton as SKEL and its dictionary, then the clip table's
+    """Member i (10.5), in the dict parse returns: the padding before it (10.1), the checks of
+    section 7 (and 9.4) on the member's bytes with the bank's skeleton as SKEL and its dictionary, then the clip table's
     Frame_Count and Frame_Time against CLIP. A failure names the clip (KanimError.clip) and
     gives its offset from the bank's first byte."""
     c = bank["clips"][i]
     member = bank["data"][c["offset"]:c["offset"] + c["size"]]
     skeleton = bank["skeletons"][c["skeleton"]]
+    start, end = c["padding"]
+    if any(bank["data"][start:end]):
+        raise KanimError("corrupt", f"{clip_label(c)}: the padding before its member (bytes {start} to {end - 1}) "
+                         "is not zero (10.1)", start, (i, c["name"]))
     try:
         major, minor, runtime, count = parse_header(member, member=True)
         if runtime != bank["runtime"]:
@@ -1063,7 +1124,7 @@ def decode_member(bank, i, check_content=True):
             content = runtime_sections(member, count, member=True)
         else:
             content = archive_sections(member, count, member=True, dictionary=bank["dictionary"])
-        content["SKEL"] = bank["data"][skeleton["offset"]:skeleton["offset"] + skeleton["size"]]
+        content["SKEL"] = skeleton["content"]
         clip = decode_runtime(content, minor, check_content) if runtime else decode_archive(content, major, minor)
     except KanimError as e:
         # The place: the field's offset in the bank where the member's parse knows it, else
@@ -1085,7 +1146,8 @@ def bank_index(bank, label):
     return {"bank": label, "format_version": "%d.%d" % bank["version"],
             "profile": "runtime" if bank["runtime"] else "archive",
             "dictionary_size": len(bank["dictionary"] or b""),
-            "skeletons": [{"offset": s["offset"], "size": s["size"]} for s in bank["skeletons"]],
+            "skeletons": [{"offset": s["offset"], "stored_size": s["stored"], "raw_size": s["raw"],
+                           "compressed": bool(s["flags"] & 1)} for s in bank["skeletons"]],
             "clips": [{"index": c["index"], "name": c["name"].decode("utf-8", errors="surrogateescape"),
                        "frame_count": c["frame_count"], "frame_time": c["frame_time"], "skeleton": c["skeleton"],
                        "offset": c["offset"], "size": c["size"]} for c in bank["clips"]]}
