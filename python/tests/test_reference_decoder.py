@@ -294,7 +294,11 @@ STRUCTURE = {
                        "checksum_mismatch", "XXH64"),
     "a byte more": (lambda: vector("v4_rules.kanim") + b"\0", "trailing_bytes", "after checksum"),
     "a byte less": (lambda: vector("v4_rules.kanim")[:-1], "truncated", "sections"),
-    "Header_Flags bit 1": (lambda: header_flags("v4_rules.kanim", 3), "reserved_bits_set", "header"),
+    # 4.1: bit 1 is Member (10.5.1: corrupt in a file read by itself), bit 2 Bank, bits 3-15 reserved
+    "Header_Flags bit 1 (Member) by itself": (lambda: header_flags("v4_rules.kanim", 3), "corrupt",
+                                              "Member set in a file read by itself"),
+    "Header_Flags bit 3": (lambda: header_flags("v4_rules.kanim", 9), "reserved_bits_set", "Header_Flags"),
+    "Member in a 3.0 file": (lambda: header_flags("v3_rules.kanim", 2, refix_crc=True), "reserved_bits_set", "Header_Flags"),
     "Runtime in a 3.0 file": (lambda: header_flags("v3_rules.kanim", 1, refix_crc=True), "reserved_bits_set", "header"),
     "IMAG longer than its arrays": (imag_grown_by_8, "corrupt", "Raw_Size against the arrays"),
     # 9.2: IMAG's header and tables

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Reference decoder for .kanim 4.0 (both profiles) and 3.0, 2.0, 1.0 (Appendix E), written from
-spec/FORMAT.md alone.
+"""Reference decoder for .kanim 4.1 (both profiles, and banks: section 10) and 3.0, 2.0, 1.0
+(Appendix E), written from spec/FORMAT.md alone.
 
 It shares no code with the C++ library: it parses the bytes, checks the rules of the spec,
 and evaluates Appendix A in binary32 (every operation computed in binary64 and rounded once to
@@ -10,12 +10,24 @@ rule of 9.4, and then its content checked too: the image is rebuilt from the rec
 compared field by field (9.4 lets a decoder skip this; an independent check should not). Its
 keys are then evaluated by the same Appendix A code as an archive file's.
 
+A bank (section 10) is opened from its header, tables, names and Bank_Checksum (10.1-10.4);
+each member is decoded on request (10.5) with the bank's skeleton as its SKEL, and a failure
+names the clip and gives offsets from the bank's first byte.
+
 Usage:
   reference_decoder.py FILE.kanim [POSITION ...]   print the values at these frame positions
   reference_decoder.py --write-json DIR            write DIR/NAME.json for every DIR/*.kanim
+  reference_decoder.py BANK                        print the bank's clip index as JSON
+  reference_decoder.py BANK NAME                   print clip NAME's expected values as JSON, as
+                                                   the .json beside a .kanim vector holds them
+  reference_decoder.py BANK:NAME [POSITION ...]    clip NAME of the bank as FILE.kanim above (the
+                                                   form keyanim's commands read)
+Exit status: 0, 1 for a file refused (the status and place on stderr) or no clip of that name,
+2 for a usage error.
 
 Needs only the Python standard library, plus either the `zstandard` module or the `zstd`
-command-line program for compressed sections (archive profile). The runtime profile's XXH64
+command-line program for compressed sections (archive profile; a bank's dictionary is given to
+either, the program taking it from a temporary file). The XXH64 of the runtime profile and banks
 uses the `xxhash` module (Debian: python3-xxhash) when it is installed, else xxh64_pure below,
 written from xxHash's specification (same results, slower).
 """
@@ -26,6 +38,7 @@ import os
 import struct
 import subprocess
 import sys
+import tempfile
 import zlib
 
 SIGNATURE = bytes([0x89, 0x4B, 0x41, 0x4E, 0x0D, 0x0A, 0x1A, 0x0A])
@@ -34,9 +47,13 @@ CRITICAL = ["CLIP", "SKEL", "CHAN", "KTIM", "KVAL"]
 
 
 class KanimError(Exception):
-    def __init__(self, status, message):
-        super().__init__(f"{status}: {message}")
-        self.status = status
+    """status: the failure's name (section 7); offset: the byte of the offending field, where
+    known (from the bank's first byte for a bank and its members); clip: (index, name) of the
+    bank's member that failed, else None."""
+
+    def __init__(self, status, message, offset=None, clip=None):
+        super().__init__(f"{status}: {message}" + ("" if offset is None else f" (at byte {offset})"))
+        self.status, self.message, self.offset, self.clip = status, message, offset, clip
 
 
 def f32(x):
@@ -53,13 +70,34 @@ def f32_bits(x):
     return struct.unpack("<I", struct.pack("<f", x))[0]
 
 
-def zstd_decompress(data):
+def zstd_decompress(data, dictionary=None):
+    """One zstd frame's content; with `dictionary` (a bank's, 10.4) decompressed with it. A frame
+    that zstd refuses is zstd_error."""
     try:
         import zstandard  # type: ignore
-        return zstandard.ZstdDecompressor().decompress(data)
     except ImportError:
-        out = subprocess.run(["zstd", "-d", "-c", "-q"], input=data, stdout=subprocess.PIPE, check=True)
-        return out.stdout
+        return zstd_program_decompress(data, dictionary)
+    try:
+        if dictionary is None:
+            return zstandard.ZstdDecompressor().decompress(data)
+        return zstandard.ZstdDecompressor(dict_data=zstandard.ZstdCompressionDict(dictionary)).decompress(data)
+    except zstandard.ZstdError as e:
+        raise KanimError("zstd_error", f"zstd: {e}")
+
+
+def zstd_program_decompress(data, dictionary):
+    """The `zstd` program's decompression (for want of the zstandard module); the dictionary
+    goes through a temporary file, removed after."""
+    with tempfile.NamedTemporaryFile(prefix="kanim-dict-") as dict_file:
+        command = ["zstd", "-d", "-c", "-q"]
+        if dictionary is not None:
+            dict_file.write(dictionary)
+            dict_file.flush()
+            command += ["-D", dict_file.name]
+        out = subprocess.run(command, input=data, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    if out.returncode:
+        raise KanimError("zstd_error", "zstd: " + out.stderr.decode("utf-8", "replace").strip())
+    return out.stdout
 
 
 def zstd_declared_size(data):
@@ -112,25 +150,40 @@ class Reader:
 def parse(data, check_content=True):
     """Returns a dict describing the clip; raises KanimError for a file that breaks the spec.
     check_content=False skips the content rules of a runtime-profile file (9.4), as a player
-    that samples in place may: only for tests that tell the two classes of rules apart."""
+    that samples in place may: only for tests that tell the two classes of rules apart.
+    A bank (section 10) is not a clip: open_bank reads it."""
     major, minor, runtime, count = parse_header(data)
     if runtime:
         return parse_runtime(data, minor, count, check_content)
-    return parse_archive(data, major, minor, count)
+    return decode_archive(archive_sections(data, count), major, minor)
 
 
-def parse_header(data):
-    """Signature and header (2.1, 2.2): (major, minor, Runtime flag, Section_Count)."""
+MEMBER, BANK = 2, 4  # Header_Flags bits 1 and 2 (version 4.1 on, section 10)
+
+
+def parse_header(data, member=False):
+    """Signature and header (2.1, 2.2): (major, minor, Runtime flag, Section_Count). member:
+    the file is a bank's member (10.5.1), whose Member bit must be set; a file by itself must
+    have it clear. Offsets are from the file's (the member's) first byte."""
     if data[:min(8, len(data))] != SIGNATURE[:min(8, len(data))]:
-        raise KanimError("bad_signature", "signature")
+        raise KanimError("bad_signature", "signature", 0)
     if len(data) < 24:
-        raise KanimError("truncated", "header")
+        raise KanimError("truncated", "header", len(data))
     major, minor, header_flags, count, reserved = struct.unpack_from("<HHIII", data, 8)
     if major not in (1, 2, 3, 4):
-        raise KanimError("unsupported_version", f"major {major}")
-    # Bit 0 is Runtime in version 4 (section 9) and reserved before; bits 1-15 are reserved.
-    if header_flags & (0xFFFE if major == 4 else 0xFFFF) or reserved:
-        raise KanimError("reserved_bits_set", "header")
+        raise KanimError("unsupported_version", f"major {major}", 8)
+    # Version 4: bit 0 Runtime (section 9), bits 1 Member and 2 Bank (4.1, section 10); before
+    # version 4 all three are reserved, and bits 3-15 always are.
+    if header_flags & (0xFFF8 if major == 4 else 0xFFFF):
+        raise KanimError("reserved_bits_set", "header: Header_Flags", 12)
+    if header_flags & BANK:
+        raise KanimError("corrupt", "header: Header_Flags has Bank set: a bank (section 10), not a clip", 12)
+    if member and not header_flags & MEMBER:
+        raise KanimError("corrupt", "header: a bank's member without the Member bit (10.5.1)", 12)
+    if not member and header_flags & MEMBER:
+        raise KanimError("corrupt", "header: Member set in a file read by itself (10.5.1)", 12)
+    if reserved:
+        raise KanimError("reserved_bits_set", "header: Header_Reserved", 20)
     return major, minor, bool(header_flags & 1), count
 
 
@@ -177,9 +230,10 @@ def parse_skel(skel, N, C):
     return nodes
 
 
-def parse_archive(data, major, minor, count):
-    """The archive profile: versions 1 to 3, and 4 with Runtime clear (laid out as 3.0)."""
-    layout = min(major, 3)  # 4.0's archive profile has 3.0's bytes (section 9)
+def archive_sections(data, count, member=False, dictionary=None):
+    """Rules 3.1-3.3 on an archive-profile file's table, sizes and CRC-32: {tag: content} of
+    the known sections, decompressed (with a bank's dictionary, 10.4). member: a bank's member,
+    whose table holds no SKEL (10.5.2)."""
     if len(data) < 24 + 24 * count + 4:
         raise KanimError("truncated", "table")
     sections = []
@@ -188,20 +242,22 @@ def parse_archive(data, major, minor, count):
         tag, flags, stored, raw = struct.unpack_from("<4sIQQ", data, 24 + 24 * i)
         tag = tag.decode("latin-1")
         if flags & 0xFFFC:
-            raise KanimError("reserved_bits_set", "section flags")
+            raise KanimError("reserved_bits_set", f"table entry {i}: section flags", 28 + 24 * i)
         sections.append((tag, flags, data[pos:pos + stored], raw))
         pos += stored
     if len(data) < pos + 4:
-        raise KanimError("truncated", "sections")
+        raise KanimError("truncated", "sections", len(data))
     if len(data) > pos + 4:
-        raise KanimError("trailing_bytes", "after checksum")
+        raise KanimError("trailing_bytes", "after checksum", pos + 4)
     if zlib.crc32(data[:pos]) != struct.unpack_from("<I", data, pos)[0]:
-        raise KanimError("checksum_mismatch", "crc")
+        raise KanimError("checksum_mismatch", "crc", pos)
 
     content = {}
     critical_seen = []
     for tag, flags, stored, raw in sections:
         ancillary = bool(flags & 2)
+        if member and tag == "SKEL":
+            raise KanimError("corrupt", "a SKEL section in a bank's member (10.5.2)")
         if tag in CRITICAL:
             if ancillary:
                 raise KanimError("corrupt", f"{tag} marked ancillary")
@@ -217,7 +273,7 @@ def parse_archive(data, major, minor, count):
             declared = zstd_declared_size(stored)
             if declared is None or declared != raw:
                 raise KanimError("zstd_error", f"{tag}: content size")
-            body = zstd_decompress(stored)
+            body = zstd_decompress(stored, dictionary)
             if len(body) != raw:
                 raise KanimError("zstd_error", f"{tag}: decompressed size")
         else:
@@ -225,9 +281,15 @@ def parse_archive(data, major, minor, count):
                 raise KanimError("corrupt", f"{tag}: raw size")
             body = stored
         content[tag] = body
-    if critical_seen != CRITICAL:
+    if critical_seen != [t for t in CRITICAL if not (member and t == "SKEL")]:
         raise KanimError("corrupt", f"critical sections {critical_seen}")
+    return content
 
+
+def decode_archive(content, major, minor):
+    """The archive profile's sections (4.1-4.6, 5): versions 1 to 3, and 4 with Runtime clear
+    (laid out as 3.0). content: {tag: content}, SKEL's being a bank's skeleton for a member."""
+    layout = min(major, 3)  # 4.0's archive profile has 3.0's bytes (section 9)
     F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
     nodes = parse_skel(content["SKEL"], N, C)
 
@@ -417,39 +479,43 @@ def xxh64(data):
 RUNTIME_SECTIONS = ["CLIP", "IMAG", "SKEL"]
 
 
-def runtime_sections(data, count):
+def runtime_sections(data, count, member=False):
     """Rules 3.1 and 9.1 on the table: CLIP, IMAG, SKEL at entries 0-2, then at most one NOTE
     (ancillary) and unknown ancillary sections, in any order; nothing compressed; the XXH64 at
-    the end. Returns {tag: content} of the known sections."""
+    the end. Returns {tag: content} of the known sections. member: a bank's member, whose
+    table has CLIP and IMAG only at entries 0-1 and no SKEL anywhere (10.5.2)."""
     if len(data) < 24 + 24 * count + 8:
         raise KanimError("truncated", "table")
+    fixed = RUNTIME_SECTIONS[:2] if member else RUNTIME_SECTIONS
     entries = [struct.unpack_from("<4sIQQ", data, 24 + 24 * i) for i in range(count)]
     tags = [e[0].decode("latin-1") for e in entries]
     for i, (_, flags, stored, raw) in enumerate(entries):
-        tag, ancillary = tags[i], bool(flags & 2)
+        tag, ancillary, at = tags[i], bool(flags & 2), 24 + 24 * i
         if flags & 0xFFFC:
-            raise KanimError("reserved_bits_set", f"table entry {i}: section flags")
-        if i < 3 and (tag != RUNTIME_SECTIONS[i] or ancillary):
-            raise KanimError("corrupt", f"table entry {i}: must be {RUNTIME_SECTIONS[i]}, critical (9.1)")
-        if i >= 3 and tag == "NOTE" and (not ancillary or tag in tags[3:i]):
-            raise KanimError("corrupt", f"table entry {i}: NOTE must be ancillary, and appear once (9.1)")
-        if i >= 3 and tag in RUNTIME_SECTIONS + CRITICAL:
-            raise KanimError("corrupt", f"table entry {i}: {tag} in a runtime-profile file (9.1)")
-        if i >= 3 and tag != "NOTE" and not ancillary:
-            raise KanimError("reserved_bits_set", f"table entry {i}: unknown critical section {tag}")
+            raise KanimError("reserved_bits_set", f"table entry {i}: section flags", at + 4)
+        if member and tag == "SKEL":
+            raise KanimError("corrupt", f"table entry {i}: a SKEL section in a bank's member (10.5.2)", at)
+        if i < len(fixed) and (tag != fixed[i] or ancillary):
+            raise KanimError("corrupt", f"table entry {i}: must be {fixed[i]}, critical (9.1)", at)
+        if i >= len(fixed) and tag == "NOTE" and (not ancillary or tag in tags[len(fixed):i]):
+            raise KanimError("corrupt", f"table entry {i}: NOTE must be ancillary, and appear once (9.1)", at)
+        if i >= len(fixed) and tag in RUNTIME_SECTIONS + CRITICAL:
+            raise KanimError("corrupt", f"table entry {i}: {tag} in a runtime-profile file (9.1)", at)
+        if i >= len(fixed) and tag != "NOTE" and not ancillary:
+            raise KanimError("reserved_bits_set", f"table entry {i}: unknown critical section {tag}", at)
         if flags & 1:
-            raise KanimError("corrupt", f"table entry {i}: {tag} compressed (9.1)")
+            raise KanimError("corrupt", f"table entry {i}: {tag} compressed (9.1)", at + 4)
         if raw != stored:
-            raise KanimError("corrupt", f"table entry {i}: {tag} Raw_Size != Stored_Size")
-    if count < 3:
-        raise KanimError("corrupt", "table: fewer than CLIP, IMAG, SKEL (9.1)")
+            raise KanimError("corrupt", f"table entry {i}: {tag} Raw_Size != Stored_Size", at + 16)
+    if count < len(fixed):
+        raise KanimError("corrupt", f"table: fewer than {', '.join(fixed)} (9.1)", 16)
     end = 24 + 24 * count + sum(e[2] for e in entries)
     if len(data) < end + 8:
-        raise KanimError("truncated", "sections")
+        raise KanimError("truncated", "sections", len(data))
     if len(data) > end + 8:
-        raise KanimError("trailing_bytes", "after checksum")
+        raise KanimError("trailing_bytes", "after checksum", end + 8)
     if xxh64(data[:end]) != struct.unpack_from("<Q", data, end)[0]:
-        raise KanimError("checksum_mismatch", "XXH64")
+        raise KanimError("checksum_mismatch", "XXH64", end)
     content, pos = {}, 24 + 24 * count
     for tag, (_, _, stored, _) in zip(tags, entries):
         if tag in RUNTIME_SECTIONS + ["NOTE"]:  # the unknown ancillary sections are skipped
@@ -460,8 +526,13 @@ def runtime_sections(data, count):
 
 def parse_runtime(data, minor, count, check_content=True):
     """A runtime-profile file (section 9): its keys recovered from IMAG, structure and content
-    checked (9.4), in the same dict as parse_archive's."""
-    content = runtime_sections(data, count)
+    checked (9.4), in the same dict as decode_archive's."""
+    return decode_runtime(runtime_sections(data, count), minor, check_content)
+
+
+def decode_runtime(content, minor, check_content=True):
+    """The runtime profile's sections (9.2-9.4). content: {tag: content}, SKEL's being a bank's
+    skeleton for a member."""
     F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
     image = parse_image(content["IMAG"], F, C, K)
     if check_content:
@@ -792,6 +863,296 @@ def check_image_content(image):
                     raise KanimError("corrupt", f"IMAG: record of block {b}, curve {i}: {name} is not what 9.3 makes of the keys")
 
 
+# ---------------------------------------------------------------------------------------------
+# Banks (section 10): many clips in one file, each distinct skeleton once, an index by position
+# and by name, a zstd dictionary for archive-profile members, a checksum per clip.
+
+BANK_HEADER_SIZE, SKELETON_ENTRY_SIZE, CLIP_ENTRY_SIZE, NAME_ORDER_ENTRY_SIZE = 40, 32, 40, 4
+DICTIONARY_MAGIC = bytes([0x37, 0xA4, 0x30, 0xEC])  # RFC 8878 section 5
+MAX_NAME_SIZE = 1024
+# The one limit of section 8 this decoder applies: 10.3 makes comparing the skeletons' Raw_Size
+# sum with it a MUST before any is inflated. keyanim's default for decompressed bytes, 1 GiB.
+DECOMPRESSED_LIMIT = 1 << 30
+ZSTD_MAX_RATIO = 32768  # section 8: no zstd frame makes more than 32768 bytes of each of its bytes
+
+
+def is_bank(data):
+    """The header says a bank (10.2): the signature, Major_Version 4 and Header_Flags' Bank bit
+    (a version 1-3 file with that bit is a clip file breaking 2.2, refused by parse)."""
+    return (len(data) >= 16 and data[:8] == SIGNATURE and struct.unpack_from("<H", data, 8)[0] == 4
+            and bool(struct.unpack_from("<I", data, 12)[0] & BANK))
+
+
+def bank_header(data):
+    """The bank header (10.2): {runtime, minor, clips, skeletons, names_size, dictionary_size}."""
+    if data[:min(8, len(data))] != SIGNATURE[:min(8, len(data))]:
+        raise KanimError("bad_signature", "signature", 0)
+    if len(data) < BANK_HEADER_SIZE:
+        raise KanimError("truncated", "bank header: the file ends inside its 40 bytes", len(data))
+    major, minor, flags, clips, skeletons, names_size, dictionary_size = struct.unpack_from("<HHIIIQQ", data, 8)
+    if major != 4:
+        raise KanimError("unsupported_version", f"bank header: major {major}", 8)
+    if flags & 0xFFF8:
+        raise KanimError("reserved_bits_set", "bank header: Header_Flags bits 3-15", 12)
+    if not flags & BANK:
+        raise KanimError("corrupt", "bank header: Header_Flags' Bank bit is clear (not a bank)", 12)
+    if flags & MEMBER:
+        raise KanimError("corrupt", "bank header: Header_Flags' Member bit is set", 12)
+    if flags & 1 and dictionary_size:
+        raise KanimError("corrupt", "bank header: a Dictionary_Size with Runtime set", 32)
+    return {"runtime": bool(flags & 1), "minor": minor, "clips": clips, "skeletons": skeletons,
+            "names_size": names_size, "dictionary_size": dictionary_size}
+
+
+def bank_tables(data, h):
+    """The skeleton table, the clip table and the name order (10.3), once their sizes and the
+    names' are known to fit in the file (10.1: nothing is allocated before)."""
+    skel_at = BANK_HEADER_SIZE
+    clip_at = skel_at + SKELETON_ENTRY_SIZE * h["skeletons"]
+    order_at = clip_at + CLIP_ENTRY_SIZE * h["clips"]
+    names_at = order_at + NAME_ORDER_ENTRY_SIZE * h["clips"]
+    if names_at + h["names_size"] > len(data):  # Python's integers: no overflow to guard
+        raise KanimError("truncated", f"bank: the tables and names ({h['skeletons']} skeletons, {h['clips']} clips, "
+                         f"Names_Size {h['names_size']}) end at byte {names_at + h['names_size']}, "
+                         f"past the file's {len(data)} bytes", len(data))
+    skeletons = []
+    for j in range(h["skeletons"]):
+        at = skel_at + SKELETON_ENTRY_SIZE * j
+        offset, stored, raw, flags, reserved = struct.unpack_from("<QQQII", data, at)
+        skeletons.append({"index": j, "offset": offset, "stored": stored, "raw": raw, "flags": flags,
+                          "reserved": reserved, "entry": at})
+    clips = []
+    for i in range(h["clips"]):
+        at = clip_at + CLIP_ENTRY_SIZE * i
+        offset, size, frame_time, frame_count, skeleton, name_offset, name_size = struct.unpack_from("<QQdIIII", data, at)
+        clips.append({"index": i, "offset": offset, "size": size, "frame_time": frame_time,
+                      "frame_count": frame_count, "skeleton": skeleton, "name_offset": name_offset,
+                      "name_size": name_size, "entry": at})
+    order = list(struct.unpack_from(f"<{h['clips']}I", data, order_at))
+    return skeletons, clips, order, order_at, names_at
+
+
+def bank_layout(data, h, skeletons, clips, names_at):
+    """10.1: every part's offset computed from the sizes before it, the tables' Offset fields
+    against it, the file's size against the end of the last part. Returns (the checksum's
+    offset, [(start, end) of each padding before the checksum]): that padding is checked when the
+    bank opens, the padding before a member (c["padding"]) with the member (10.1)."""
+    padding = []
+
+    def align(pos):
+        padding.append((pos, pad8(pos)))
+        return pad8(pos)
+
+    pos = align(names_at + h["names_size"]) + h["dictionary_size"]
+    for j, s in enumerate(skeletons):
+        at = align(pos)
+        if s["offset"] != at:
+            raise KanimError("corrupt", f"skeleton table entry {j}: Offset {s['offset']}, the layout puts skeleton {j} at {at} (10.1)", s["entry"])
+        if s["stored"] < 1:
+            raise KanimError("corrupt", f"skeleton table entry {j}: Stored_Size 0 (10.3)", s["entry"] + 8)
+        pos = at + s["stored"]
+    checksum_at = align(pos)
+    pos = checksum_at + 8
+    for c in clips:
+        at = align(pos)
+        c["padding"] = padding.pop()
+        if c["offset"] != at:
+            raise KanimError("corrupt", f"clip table entry {c['index']}: Offset {c['offset']}, the layout puts member "
+                             f"{c['index']} at {at} (10.1)", c["entry"])
+        pos = at + c["size"]
+    if len(data) < pos:
+        raise KanimError("truncated", f"bank: the last part ends at byte {pos}, past the file's {len(data)} bytes", len(data))
+    if len(data) > pos:
+        raise KanimError("trailing_bytes", f"bank: {len(data) - pos} bytes after the last part", pos)
+    return checksum_at, padding
+
+
+def check_skeleton_entries(skeletons):
+    """The skeleton table's fields (10.3) that need no more than the table: flags, Raw_Size,
+    and a compressed one's Raw_Size within 32768 times its Stored_Size (section 8); then the
+    sum of Raw_Size against the limit, before anything is inflated."""
+    for s in skeletons:
+        j, at = s["index"], s["entry"]
+        if s["flags"] & 0xFFFE:
+            raise KanimError("reserved_bits_set", f"skeleton table entry {j}: Skeleton_Flags bits 1-15", at + 24)
+        if s["reserved"]:
+            raise KanimError("reserved_bits_set", f"skeleton table entry {j}: Skeleton_Reserved", at + 28)
+        if s["raw"] < 1:
+            raise KanimError("corrupt", f"skeleton table entry {j}: Raw_Size 0 (10.3)", at + 16)
+        if not s["flags"] & 1 and s["raw"] != s["stored"]:
+            raise KanimError("corrupt", f"skeleton table entry {j}: not Compressed, Raw_Size {s['raw']} != "
+                             f"Stored_Size {s['stored']} (3.2.4)", at + 16)
+        if s["flags"] & 1 and s["raw"] > ZSTD_MAX_RATIO * s["stored"]:
+            raise KanimError("zstd_error", f"skeleton table entry {j}: Raw_Size {s['raw']} > 32768 x Stored_Size "
+                             f"{s['stored']} (section 8)", at + 16)
+    total = sum(s["raw"] for s in skeletons)
+    if total > DECOMPRESSED_LIMIT:
+        raise KanimError("limit_exceeded", f"skeleton table: the skeletons' Raw_Size sum {total} > the limit "
+                         f"{DECOMPRESSED_LIMIT} (10.3, section 8)", BANK_HEADER_SIZE)
+
+
+def skeleton_content(data, s):
+    """A skeleton's content (10.3): its stored bytes, or the one zstd frame they hold (made
+    without the bank's dictionary) declaring and inflating to Raw_Size bytes."""
+    stored = data[s["offset"]:s["offset"] + s["stored"]]
+    if not s["flags"] & 1:
+        return stored
+    where = f"skeleton {s['index']} (bytes {s['offset']} to {s['offset'] + s['stored'] - 1})"
+    try:
+        declared = zstd_declared_size(stored)
+        if declared != s["raw"]:
+            raise KanimError("zstd_error", f"its frame declares {declared} bytes, not Raw_Size {s['raw']}")
+        content = zstd_decompress(stored)
+        if len(content) != s["raw"]:
+            raise KanimError("zstd_error", f"it inflates to {len(content)} bytes, not Raw_Size {s['raw']}")
+    except KanimError as e:
+        raise KanimError("zstd_error", f"{where}: {e.message}", s["offset"]) from e
+    return content
+
+
+def check_clip_entries(clips, h):
+    """The clip table's fields that need no more than the tables (10.3): Skeleton, Name_Size,
+    the name within the pool."""
+    for c in clips:
+        i, at = c["index"], c["entry"]
+        if c["skeleton"] >= h["skeletons"]:
+            raise KanimError("corrupt", f"clip table entry {i}: Skeleton {c['skeleton']} >= Skeleton_Count {h['skeletons']}", at + 28)
+        if not 1 <= c["name_size"] <= MAX_NAME_SIZE:
+            raise KanimError("corrupt", f"clip table entry {i}: Name_Size {c['name_size']} not within 1 to {MAX_NAME_SIZE}", at + 36)
+        if c["name_offset"] + c["name_size"] > h["names_size"]:
+            raise KanimError("corrupt", f"clip table entry {i}: the name (Name_Offset {c['name_offset']}, Name_Size "
+                             f"{c['name_size']}) ends past Names_Size {h['names_size']}", at + 32)
+
+
+def check_name(name, i, at):
+    """A name (10.3): no byte 0; split at '/', no part empty, '.' or '..'."""
+    if 0 in name:
+        raise KanimError("corrupt", f"clip {i}: its name holds a byte 0", at + name.index(0))
+    for part in name.split(b"/"):
+        if part in (b"", b".", b".."):
+            raise KanimError("corrupt", f"clip {i}: its name {name!r} has a part {part.decode()!r} (10.3)", at)
+
+
+def check_name_order(order, clips, order_at):
+    """The name order (10.3): every clip once, in strictly increasing order of name (bytes
+    compared as unsigned values, a name before every longer one it begins: Python's bytes <)."""
+    seen = [False] * len(clips)
+    for k, i in enumerate(order):
+        if i >= len(clips) or seen[i]:
+            raise KanimError("corrupt", f"name order entry {k}: clip {i} " + ("out of range" if i >= len(clips) else "listed twice"),
+                             order_at + 4 * k)
+        seen[i] = True
+    for k in range(1, len(order)):
+        a, b = clips[order[k - 1]], clips[order[k]]
+        if not a["name"] < b["name"]:
+            why = "share the name" if a["name"] == b["name"] else "are out of order"
+            raise KanimError("corrupt", f"name order entries {k - 1} and {k}: clips {a['index']} and {b['index']} "
+                             f"{why} {a['name']!r}" + ("" if a["name"] == b["name"] else f", {b['name']!r}"), order_at + 4 * k)
+
+
+def open_bank(data):
+    """Opens a bank (10.1-10.4) from its index, reading no member: header, tables, layout and
+    file size, the tables' fields, the skeletons' size limit, then Bank_Checksum, then the
+    padding before it, dictionary magic, names and their order, and the skeletons inflated.
+    Returns {data, runtime, version, dictionary, skeletons, clips, order}; clips[i] holds
+    index, name (bytes), frame_count, frame_time, skeleton, offset and size."""
+    h = bank_header(data)
+    skeletons, clips, order, order_at, names_at = bank_tables(data, h)
+    checksum_at, padding = bank_layout(data, h, skeletons, clips, names_at)
+    check_skeleton_entries(skeletons)
+    check_clip_entries(clips, h)
+    if xxh64(data[:checksum_at]) != struct.unpack_from("<Q", data, checksum_at)[0]:
+        raise KanimError("checksum_mismatch", "Bank_Checksum (XXH64 of the bank's bytes before it)", checksum_at)
+    for start, end in padding:
+        if any(data[start:end]):
+            raise KanimError("corrupt", f"bank: padding bytes {start} to {end - 1} not zero (10.1)", start)
+    dictionary = None
+    if h["dictionary_size"]:
+        dict_at = pad8(names_at + h["names_size"])
+        dictionary = data[dict_at:dict_at + h["dictionary_size"]]
+        if dictionary[:4] != DICTIONARY_MAGIC:
+            raise KanimError("corrupt", "dictionary: not a zstd dictionary (its first bytes are not 37 A4 30 EC, 10.4)", dict_at)
+    for c in clips:
+        at = names_at + c["name_offset"]
+        c["name"] = data[at:at + c["name_size"]]
+        check_name(c["name"], c["index"], at)
+    check_name_order(order, clips, order_at)
+    for s in skeletons:
+        s["content"] = skeleton_content(data, s)  # inflated once for all the clips of the skeleton
+    return {"data": data, "runtime": h["runtime"], "version": (4, h["minor"]), "dictionary": dictionary,
+            "skeletons": skeletons, "clips": clips, "order": order}
+
+
+def find_clip(bank, name):
+    """The index of the clip named `name` (bytes), by binary search over the name order; None
+    when there is none."""
+    clips, order = bank["clips"], bank["order"]
+    lo, hi = 0, len(order)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        other = clips[order[mid]]["name"]
+        if other == name:
+            return order[mid]
+        if other < name:
+            lo = mid + 1
+        else:
+            hi = mid
+    return None
+
+
+def clip_label(c):
+    return f"clip {c['index']} {c['name'].decode('utf-8', errors='surrogateescape')!r}"
+
+
+def decode_member(bank, i, check_content=True):
+    """Member i (10.5), in the dict parse returns: the padding before it (10.1), the checks of
+    section 7 (and 9.4) on the member's bytes with the bank's skeleton as SKEL and its dictionary, then the clip table's
+    Frame_Count and Frame_Time against CLIP. A failure names the clip (KanimError.clip) and
+    gives its offset from the bank's first byte."""
+    c = bank["clips"][i]
+    member = bank["data"][c["offset"]:c["offset"] + c["size"]]
+    skeleton = bank["skeletons"][c["skeleton"]]
+    start, end = c["padding"]
+    if any(bank["data"][start:end]):
+        raise KanimError("corrupt", f"{clip_label(c)}: the padding before its member (bytes {start} to {end - 1}) "
+                         "is not zero (10.1)", start, (i, c["name"]))
+    try:
+        major, minor, runtime, count = parse_header(member, member=True)
+        if runtime != bank["runtime"]:
+            raise KanimError("corrupt", "header: Runtime differs from the bank's (10.5.1)", 12)
+        if runtime:
+            content = runtime_sections(member, count, member=True)
+        else:
+            content = archive_sections(member, count, member=True, dictionary=bank["dictionary"])
+        content["SKEL"] = skeleton["content"]
+        clip = decode_runtime(content, minor, check_content) if runtime else decode_archive(content, major, minor)
+    except KanimError as e:
+        # The place: the field's offset in the bank where the member's parse knows it, else
+        # the member's first byte (the message names the section).
+        raise KanimError(e.status, f"{clip_label(c)} (member at bytes {c['offset']} to {c['offset'] + c['size'] - 1} "
+                         f"of the bank, skeleton {c['skeleton']}): {e.message}",
+                         c["offset"] + (e.offset or 0), (i, c["name"])) from e
+    if clip["frame_count"] != c["frame_count"]:
+        raise KanimError("corrupt", f"{clip_label(c)}: the clip table's Frame_Count {c['frame_count']} is not CLIP's "
+                         f"{clip['frame_count']} (10.5)", c["entry"] + 24, (i, c["name"]))
+    if struct.pack("<d", clip["frame_time"]) != struct.pack("<d", c["frame_time"]):
+        raise KanimError("corrupt", f"{clip_label(c)}: the clip table's Frame_Time {c['frame_time']!r} is not CLIP's "
+                         f"{clip['frame_time']!r}, bit for bit (10.5)", c["entry"] + 16, (i, c["name"]))
+    return clip
+
+
+def bank_index(bank, label):
+    """The bank's clip index, as `reference_decoder.py BANK` prints it."""
+    return {"bank": label, "format_version": "%d.%d" % bank["version"],
+            "profile": "runtime" if bank["runtime"] else "archive",
+            "dictionary_size": len(bank["dictionary"] or b""),
+            "skeletons": [{"offset": s["offset"], "stored_size": s["stored"], "raw_size": s["raw"],
+                           "compressed": bool(s["flags"] & 1)} for s in bank["skeletons"]],
+            "clips": [{"index": c["index"], "name": c["name"].decode("utf-8", errors="surrogateescape"),
+                       "frame_count": c["frame_count"], "frame_time": c["frame_time"], "skeleton": c["skeleton"],
+                       "offset": c["offset"], "size": c["size"]} for c in bank["clips"]]}
+
+
 def segment_value(k, v, n, j, u, interp, tension, rule):
     """Appendix A, segment j at local parameter u; every operation rounded to binary32."""
     p0, p1 = v[j], v[j + 1]
@@ -859,15 +1220,17 @@ def positions_for(frame_count):
     return ps
 
 
-def write_json(path):
-    data = open(path, "rb").read()
-    clip = parse(data)
+def expected_values(clip, vector, clip_name=None):
+    """What a vector's .json holds: the clip's facts and its values at positions_for's
+    positions. vector: the file's name; clip_name: the clip's name in a bank (a "clip" field)."""
     samples = []
     for x in positions_for(clip["frame_count"]):
         samples.append({"position": x,
                         "values": [channel_value(clip, c, x) for c in range(len(clip["frames"]))]})
-    out = {
-        "vector": os.path.basename(path),
+    out = {"vector": vector}
+    if clip_name is not None:
+        out["clip"] = clip_name
+    out.update({
         "format_version": "%d.%d" % clip["version"],
         "generated_by": "spec/test-vectors/reference_decoder.py",
         "frame_count": clip["frame_count"],
@@ -876,15 +1239,67 @@ def write_json(path):
         "notes": clip["notes"],
         "nodes": clip["nodes"],
         "samples": samples,
-    }
-    json_path = os.path.splitext(path)[0] + ".json"
-    # One sample per line: readable, and diffs show which position changed.
+    })
+    return out
+
+
+def json_text(out):
+    """expected_values' dict as the vectors' .json text: one sample per line (readable, and
+    diffs show which position changed)."""
     header = json.dumps({k: v for k, v in out.items() if k != "samples"}, indent=1)
-    lines = ",\n".join("  " + json.dumps(sample) for sample in samples)
+    lines = ",\n".join("  " + json.dumps(sample) for sample in out["samples"])
+    text = header[:-2] + ',\n "samples": [\n' + lines + "\n ]\n}\n"
+    json.loads(text)  # the hand-assembled text must still be JSON
+    return text
+
+
+def write_json(path):
+    clip = parse(open(path, "rb").read())
+    json_path = os.path.splitext(path)[0] + ".json"
     with open(json_path, "w") as fh:
-        fh.write(header[:-2] + ',\n "samples": [\n' + lines + "\n ]\n}\n")
-    json.load(open(json_path))  # the hand-assembled text must still be JSON
+        fh.write(json_text(expected_values(clip, os.path.basename(path))))
     return json_path
+
+
+def bank_main(path, data, names):
+    """`reference_decoder.py BANK [NAME]`: the index, or clip NAME's expected values."""
+    bank = open_bank(data)
+    if not names:
+        print(json.dumps(bank_index(bank, os.path.basename(path)), indent=1))
+        return 0
+    name = os.fsencode(names[0])  # the argument's bytes, as the OS gave them
+    i = find_clip(bank, name)
+    if i is None:
+        print(f"{path}: no clip named {names[0]!r}", file=sys.stderr)
+        return 1
+    clip = decode_member(bank, i)
+    sys.stdout.write(json_text(expected_values(clip, os.path.basename(path), names[0])))
+    return 0
+
+
+def split_bank_clip(arg):
+    """BANK:NAME -> (BANK, NAME) when arg is no file but its part before a ':' is (a name may
+    hold ':' too: the first such part that is a file); else (arg, None)."""
+    if os.path.exists(arg):
+        return arg, None
+    at = arg.find(":")
+    while at >= 0:
+        if os.path.isfile(arg[:at]):
+            return arg[:at], arg[at + 1:]
+        at = arg.find(":", at + 1)
+    return arg, None
+
+
+def read_clip(path, name):
+    """The clip of FILE.kanim (name None), or clip `name` of bank `path`."""
+    data = open(path, "rb").read()
+    if name is None:
+        return parse(data)
+    bank = open_bank(data)
+    i = find_clip(bank, os.fsencode(name))
+    if i is None:
+        raise KanimError("not_found", f"no clip named {name!r}")
+    return decode_member(bank, i)
 
 
 def main(argv):
@@ -892,11 +1307,18 @@ def main(argv):
         for p in sorted(glob.glob(os.path.join(argv[2], "*.kanim"))):
             print(write_json(p))
         return 0
-    if len(argv) >= 2:
+    if len(argv) >= 2 and not argv[1].startswith("--"):
+        path, name = split_bank_clip(argv[1])
         try:
-            clip = parse(open(argv[1], "rb").read())
+            data = open(path, "rb").read() if name is None else None
+            if data is not None and is_bank(data):
+                if len(argv) > 3:
+                    print(__doc__, file=sys.stderr)
+                    return 2
+                return bank_main(path, data, argv[2:])
+            clip = read_clip(path, name)
         except KanimError as e:
-            print(e, file=sys.stderr)
+            print(f"{path}: {e}", file=sys.stderr)
             return 1
         for x in [float(a) for a in argv[2:]] or [0.0]:
             print(x, [channel_value(clip, c, x) for c in range(len(clip["frames"]))])
