@@ -12,40 +12,15 @@
 #include <emmintrin.h>
 #endif
 
+#include "internal/cpu.h"
 #include "keyanim/offline/error.h"
+#include "offline/fk_loop.h"
 
 namespace keyanim::offline {
 namespace {
 
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 constexpr Mat3 kIdentity{1, 0, 0, 0, 1, 0, 0, 0, 1};
 
-
-// sin and cos of |x| <= pi/4 (error < 1 ulp): fdlibm's __kernel_sin and __kernel_cos with a
-// zero tail. In-house rather than libm's so that FK gives the same bits on every platform and
-// libm version, in a fraction of the instructions (the encoder's verification is mostly FK).
-//
-// Copyright (C) 1993 by Sun Microsystems, Inc. All rights reserved.
-// Developed at SunPro, a Sun Microsystems, Inc. business.
-// Permission to use, copy, modify, and distribute this software is freely granted, provided
-// that this notice is preserved.
-template <class D>  // double, or Lanes2 below: the same operations on each lane
-inline void kernel_sin_cos(D x, D& s, D& c) noexcept {
-  constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                   S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                   S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
-  constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                   C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                   C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-  const D z = x * x;
-  const D w = z * z;
-  const D rs = D(S2) + z * (D(S3) + z * D(S4)) + z * w * (D(S5) + z * D(S6));
-  s = x + z * x * (D(S1) + z * rs);
-  const D rc = z * (D(C1) + z * (D(C2) + z * D(C3))) + w * w * (D(C4) + z * (D(C5) + z * D(C6)));
-  const D hz = D(0.5) * z;
-  const D one_minus = D(1.0) - hz;
-  c = one_minus + (((D(1.0) - one_minus) - hz) + z * rc);
-}
 
 // Two doubles at once (two frames posed together): SSE2 where there is SSE2 (every x86-64),
 // else two plain doubles. Each lane goes through exactly the operations of a double.
@@ -153,33 +128,6 @@ inline void sin_cos_deg2(Lanes2 deg, Lanes2& s, Lanes2& c) noexcept {
 
 namespace {
 
-// m = m * R_axis(angle). Only the two columns other than `axis` change:
-// col_a' = c*col_a + s*col_b, col_b' = c*col_b - s*col_a with (a, b) = (axis+1, axis+2) mod 3.
-// One instance per axis, so that the indices are constants (FK is most of the encoder's time).
-template <int Axis, class D>
-inline void post_rotate_axis(std::array<D, 9>& m, D s, D c) noexcept {
-  constexpr int a = (Axis + 1) % 3;
-  constexpr int b = (Axis + 2) % 3;
-  for (int r = 0; r < 3; ++r) {
-    const D ma = m[r * 3 + a];
-    const D mb = m[r * 3 + b];
-    m[r * 3 + a] = c * ma + s * mb;
-    m[r * 3 + b] = c * mb - s * ma;
-  }
-}
-template <class D>
-inline void post_rotate(std::array<D, 9>& m, int axis, D s, D c) noexcept {
-  switch (axis) {
-    case 0: return post_rotate_axis<0>(m, s, c);
-    case 1: return post_rotate_axis<1>(m, s, c);
-    default: return post_rotate_axis<2>(m, s, c);
-  }
-}
-
-inline bool is_root(const Joint& joint, size_t index) noexcept {
-  return joint.parent < 0 || static_cast<size_t>(joint.parent) >= index;
-}
-
 // Where pose_frame gets a channel's value and the sine and cosine of a rotation's.
 struct OneRow {
   using D = double;
@@ -202,48 +150,6 @@ struct TwoRows {
   D value(uint32_t column) const noexcept { return {a[column], b[column]}; }
   void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg2(value(column), s, c); }
 };
-
-// The one FK loop everything else uses, on one frame (double) or two (Lanes2). pos and rot have
-// room for every node. With `nodes`, only the nodes it marks (a set holding every ancestor of
-// its members) are computed.
-template <typename Values, typename D = typename Values::D>
-void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
-                const uint8_t* nodes = nullptr, PositionReading reading = PositionReading::replace) noexcept {
-  const bool add = reading == PositionReading::add;
-  const D zero(0.0), one(1.0);
-  const std::array<D, 9> identity{one, zero, zero, zero, one, zero, zero, zero, one};
-  const size_t n = skeleton.joints.size();
-  for (size_t j = 0; j < n; ++j) {
-    if (nodes && !nodes[j]) continue;
-    const Joint& joint = skeleton.joints[j];
-    const bool root = is_root(joint, j);
-    const std::array<D, 9>& parent_rot = root ? identity : rot[joint.parent];
-    std::array<D, 3> t{D(joint.offset[0]), D(joint.offset[1]), D(joint.offset[2])};
-    std::array<D, 9>& r = rot[j];
-    r = parent_rot;
-    for (size_t k = 0; k < joint.channels.size(); ++k) {
-      const ChannelType type = joint.channels[k];
-      const uint32_t column = joint.first_channel + uint32_t(k);
-      if (is_rotation(type)) {
-        D sn, cs;
-        values.sin_cos(column, sn, cs);
-        post_rotate(r, channel_axis(type), sn, cs);
-      } else {
-        const size_t axis = static_cast<size_t>(channel_axis(type));
-        t[axis] = add ? D(joint.offset[axis]) + values.value(column) : values.value(column);
-      }
-    }
-    if (root) {
-      pos[j] = t;
-    } else {
-      const std::array<D, 3>& pp = pos[joint.parent];
-      const std::array<D, 9>& m = parent_rot;
-      pos[j] = {pp[0] + m[0] * t[0] + m[1] * t[1] + m[2] * t[2],
-                pp[1] + m[3] * t[0] + m[4] * t[1] + m[5] * t[2],
-                pp[2] + m[6] * t[0] + m[7] * t[1] + m[8] * t[2]};
-    }
-  }
-}
 
 }  // namespace
 
@@ -332,6 +238,17 @@ void world_points(const Skeleton& skeleton, const double* row_a, const double* r
       a[1] = a[2] = a[3] = a[0], b[1] = b[2] = b[3] = b[0];
     }
   }
+}
+
+void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
+                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out) {
+  if (internal::cpu_level() == internal::CpuLevel::v3) {
+    Vec3* points[4];
+    for (size_t i = 0; i < 4; ++i) out[i].resize(4 * skeleton.joints.size()), points[i] = out[i].data();
+    if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points)) return;
+  }
+  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1]);
+  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3]);
 }
 
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,

@@ -69,6 +69,12 @@ void measured_points(const Skeleton& skeleton, const double* row_a, const double
   world_points(skeleton, row_a, row_b, nodes, reading, shell, points_a, points_b);  // node_points, two at once
 }
 
+void measured_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, double shell,
+                     PositionReading reading, std::array<std::vector<std::array<double, 3>>, 4>& points,
+                     const uint8_t* nodes) {
+  world_points(skeleton, rows, nodes, reading, shell, points);  // node_points, four at once
+}
+
 std::string point_name(const Skeleton& s, uint32_t node, uint32_t point) {
   if (node >= s.joints.size()) return "?";
   const Joint& j = s.joints[node];

@@ -64,6 +64,10 @@ void world_positions(const Skeleton& skeleton, const double* row_a, const double
 // what world_pose gives, bit for bit.
 void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
                   PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b);
+// Four frame rows at once, into out[0..4): bit for bit what the above gives for rows 0 and 1,
+// then 2 and 3; in four AVX lanes on x86-64-v3 machines (internal/cpu.h; KEYANIM_CPU caps it).
+void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
+                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values

@@ -94,6 +94,47 @@ void FrameMarks::mark(uint32_t node, uint32_t first, uint32_t last) {
 
 void FrameMarks::clear_moved() { std::fill(moved_.begin(), moved_.end(), 0); }
 
+namespace {
+
+// Marks in w.measure[k] the nodes to measure at frame f: all, or the subtrees of the nodes that
+// moved; adds them to w.pose.
+void select_nodes(const Skeleton& s, const FrameMarks& marks, uint8_t check, uint32_t f, size_t k, VerifyScratch& w) {
+  const bool all = check & FrameMarks::kOver;
+  uint8_t* measure = w.measure[k].data();
+  for (size_t j = 0; j < s.joints.size(); ++j) {
+    const int32_t p = s.joints[j].parent;
+    measure[j] = all || marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && measure[size_t(p)]);
+    w.pose[j] |= measure[j];
+    w.error[k][j] = 0.0, w.shell_over[k][j] = 0;
+  }
+}
+
+// Largest distance per measured node between the original's points and the decoded's, into
+// w.error[k] (the formula of measure_error, so that what passes here passes the final report;
+// the square is compared first against a bound safely inside the tolerance: sqrt is correctly
+// rounded).
+void add_errors(const Skeleton& s, double tol, double shell, const std::vector<Vec3>& original,
+                const std::vector<Vec3>& decoded, size_t k, VerifyScratch& w) {
+  const double surely_within = tol * tol * (1.0 - 1e-9);
+  for (size_t d = 0; d < s.joints.size(); ++d) {
+    if (!w.measure[k][d]) continue;
+    const size_t first_point = d * kPointsPerNode;
+    const size_t points = measured_point_count(s.joints[d], shell);
+    for (size_t p = first_point; p < first_point + points; ++p) {
+      const Vec3& a = original[p];
+      const Vec3& b = decoded[p];
+      const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+      const double sq = dx * dx + dy * dy + dz * dz;
+      if (sq <= surely_within) continue;
+      const double pe = std::isnan(sq) ? HUGE_VAL : std::sqrt(sq);  // a NaN is over, and stays the worst
+      w.error[k][d] = std::max(w.error[k][d], pe);
+      if (p > first_point && pe > tol) w.shell_over[k][d] = 1;
+    }
+  }
+}
+
+}  // namespace
+
 void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
                    double shell, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
                    VerifyScratch& w) {
@@ -103,62 +144,52 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
   const std::span<const PositionReading> readings = measured_readings(m.skeleton);
   w.cursors.resize(n_ch);
   for (size_t c = 0; c < n_ch; ++c) w.cursors[c] = ChannelCursor(channels[c], rule);
-  w.row.resize(n_ch);
-  w.measure.resize(nodes);
+  w.frames.clear();
+  for (uint32_t f = first; f < first + count; ++f)
+    if (check[f]) w.frames.push_back(f);
+  for (size_t k = 0; k < 2; ++k) {
+    w.row[k].resize(n_ch), w.measure[k].resize(nodes), w.error[k].resize(nodes), w.shell_over[k].resize(nodes);
+  }
   w.pose.resize(nodes);
-  w.error.resize(nodes);
-  w.shell_over.resize(nodes);
-  // The formula of measure_error, so that what passes here passes the final report; the square
-  // is compared first against a bound safely inside it (sqrt is correctly rounded).
-  const double surely_within = tol * tol * (1.0 - 1e-9);
-  for (uint32_t f = first; f < first + count; ++f) {
-    if (!check[f]) continue;
-    // Nodes to measure: all, or the subtrees of the nodes that moved; to pose: those and
-    // their ancestors.
-    const bool all = check[f] & FrameMarks::kOver;
-    for (size_t j = 0; j < nodes; ++j) {
-      const int32_t p = joints[j].parent;
-      w.measure[j] = all || marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && w.measure[size_t(p)]);
-      w.pose[j] = w.measure[j];
-      w.error[j] = 0.0, w.shell_over[j] = 0;
-    }
-    for (size_t j = nodes; j-- > 0;) {
+  // Two frames at a time: one FK poses both frames' original and decoded rows (four lanes).
+  for (size_t i = 0; i < w.frames.size(); i += 2) {
+    const size_t pair = std::min<size_t>(2, w.frames.size() - i);
+    std::fill(w.pose.begin(), w.pose.end(), 0);
+    for (size_t k = 0; k < pair; ++k) select_nodes(m.skeleton, marks, check[w.frames[i + k]], w.frames[i + k], k, w);
+    for (size_t j = nodes; j-- > 0;) {  // and their ancestors
       const int32_t p = joints[j].parent;
       if (w.pose[j] && p >= 0 && size_t(p) < j) w.pose[size_t(p)] = 1;
     }
-    for (size_t j = 0; j < nodes; ++j) {
-      if (!w.pose[j]) continue;
-      for (size_t k = 0; k < joints[j].channels.size(); ++k) {
-        const size_t c = joints[j].first_channel + k;
-        w.row[c] = w.cursors[c].at(f);
+    const double* original[2];
+    for (size_t k = 0; k < pair; ++k) {
+      const uint32_t f = w.frames[i + k];
+      for (size_t j = 0; j < nodes; ++j) {
+        if (!w.pose[j]) continue;
+        for (size_t c = joints[j].first_channel; c < joints[j].first_channel + joints[j].channels.size(); ++c)
+          w.row[k][c] = w.cursors[c].at(f);
       }
+      original[k] = m.values.data() + size_t(f) * n_ch;
     }
-    const double* original = m.values.data() + size_t(f) * n_ch;
     for (const PositionReading reading : readings) {
-      measured_points(m.skeleton, original, w.row.data(), shell, reading, w.original, w.decoded, w.pose.data());
-      for (size_t d = 0; d < nodes; ++d) {
-        if (!w.measure[d]) continue;
-        const size_t first_point = d * kPointsPerNode;
-        const size_t points = measured_point_count(joints[d], shell);
-        for (size_t p = first_point; p < first_point + points; ++p) {
-          const Vec3& a = w.original[p];
-          const Vec3& b = w.decoded[p];
-          const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-          const double sq = dx * dx + dy * dy + dz * dz;
-          if (sq <= surely_within) continue;
-          const double pe = std::isnan(sq) ? HUGE_VAL : std::sqrt(sq);  // a NaN is over, and stays the worst
-          w.error[d] = std::max(w.error[d], pe);
-          if (p > first_point && pe > tol) w.shell_over[d] = 1;
-        }
+      if (pair == 2) {
+        measured_points(m.skeleton, {original[0], w.row[0].data(), original[1], w.row[1].data()}, shell, reading,
+                        w.points, w.pose.data());
+      } else {
+        measured_points(m.skeleton, original[0], w.row[0].data(), shell, reading, w.points[0], w.points[1],
+                        w.pose.data());
       }
+      for (size_t k = 0; k < pair; ++k) add_errors(m.skeleton, tol, shell, w.points[2 * k], w.points[2 * k + 1], k, w);
     }
-    bool frame_over = false;
-    for (size_t d = 0; d < nodes; ++d) {
-      if (!w.measure[d] || w.error[d] <= tol) continue;
-      over.push_back({f, uint32_t(d) & 0x7FFFFFFFu, w.shell_over[d] != 0u, w.error[d]});  // nodes < 2^31
-      frame_over = true;
+    for (size_t k = 0; k < pair; ++k) {
+      const uint32_t f = w.frames[i + k];
+      bool frame_over = false;
+      for (size_t d = 0; d < nodes; ++d) {
+        if (!w.measure[k][d] || w.error[k][d] <= tol) continue;
+        over.push_back({f, uint32_t(d) & 0x7FFFFFFFu, w.shell_over[k][d] != 0u, w.error[k][d]});  // nodes < 2^31
+        frame_over = true;
+      }
+      check[f] = frame_over ? FrameMarks::kOver : 0;
     }
-    check[f] = frame_over ? FrameMarks::kOver : 0;
   }
 }
 

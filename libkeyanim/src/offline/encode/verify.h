@@ -4,6 +4,7 @@
 // with the clip. Internal to the encoder.
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -88,14 +89,17 @@ class FrameMarks {
   std::vector<uint64_t> moved_;  // per node, a bit per frame
 };
 
-// Working memory of verify_window, one per thread.
+// Working memory of verify_window, one per thread. Frames are verified two at a time (four
+// rows posed together: each frame's original and decoded), index k = 0, 1 of the pair.
 struct VerifyScratch {
   std::vector<ChannelCursor> cursors;
-  std::vector<double> row;
-  std::vector<uint8_t> measure, pose;  // per node: its error is measured; it is posed
-  std::vector<double> error;           // per node: the largest distance over the readings
-  std::vector<uint8_t> shell_over;     // per node: a shell point is over
-  std::vector<Vec3> original, decoded;
+  std::vector<uint32_t> frames;                // of the window, to verify
+  std::array<std::vector<double>, 2> row;      // decoded
+  std::array<std::vector<uint8_t>, 2> measure; // per node: its error is measured
+  std::vector<uint8_t> pose;                   // per node: posed (for either frame)
+  std::array<std::vector<double>, 2> error;    // per node: the largest distance over the readings
+  std::array<std::vector<uint8_t>, 2> shell_over;  // per node: a shell point is over
+  std::array<std::vector<Vec3>, 4> points;     // original, decoded of frame 0; of frame 1
 };
 
 // Verifies the frames f of [first, first + count) marked in `marks`: decodes the channels of
