@@ -22,6 +22,7 @@ REQUIRED=(
   bash-completion  # tab completion of the installed tool (tools/completion/keyanim)
   parallel procps  # tests/cli/manifest_test.sh runs the README's GNU parallel recipe (and kills it)
   libxxhash-dev python3-xxhash  # the runtime profile's checksum, XXH64 (spec/FORMAT.md section 9)
+  zstd             # python/tests/test_reference_bank.py: the zstd program trains and applies a bank dictionary
   locales          # python/tests/test_hostile.py compiles de_DE.UTF-8 (localedef) into its own directory
   # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
   # matplotlib for examples/plot_channel.py.
