@@ -360,9 +360,15 @@ TEST_CASE("runtime profile: the file's own rules (9.1: table, checksum, size) br
   }
   SUBCASE("a reserved Header_Flags bit beside Runtime") {
     std::vector<uint8_t> b = good;
-    b[12] |= 2;
+    b[12] |= 8;  // bits 1 and 2 are Member and Bank from version 4.1 (section 10)
     fix_xxh64(b);
     check_refused(b, Status::reserved_bits_set, "header", 12);
+  }
+  SUBCASE("Member set: a bank's clip read by itself (10.5)") {
+    std::vector<uint8_t> b = good;
+    b[12] |= 2;
+    fix_xxh64(b);
+    check_refused(b, Status::corrupt, "header", 12);
   }
   SUBCASE("Runtime cleared: an archive file (9), where IMAG is an unknown critical section (3.2, rule 2)") {
     std::vector<uint8_t> b = good;
