@@ -210,7 +210,7 @@ TEST_CASE("open_file maps regular files only: a FIFO is refused without waiting 
   ::rmdir(dir);
 }
 
-TEST_CASE("a damaged clip fails by its name; the others still load") {
+TEST_CASE("a damaged clip fails by its name, and the others still load") {
   off::BankOptions o;
   o.dictionary = off::BankDictionary::always;
   std::vector<uint8_t> b = off::write_bank(inputs(), o).bytes;
