@@ -831,3 +831,25 @@ def test_keyanim_refuses_the_broken_member_too(case, tmp_path):
     other = w.clips[(i + 1) % len(w.clips)]["name"].decode()  # another clip of the bank still converts
     code, _, err = tool_status(["-q", "convert", f"{path}:{other}", "--archive", "-o", tmp_path / "other.kanim"])
     assert code == 0, err
+
+
+# ---- The b41_* vectors (keyanim pack, Appendix C): each clip, named after its vector, decodes
+# to that vector's expected values; b41_damaged's v3_uniform fails alone.
+
+@pytest.mark.parametrize("name", ["b41_archive", "b41_dictionary", "b41_runtime", "b41_damaged"])
+def test_the_b41_vectors_decode_to_their_clips_vectors(name):
+    bank = rd.open_bank(vector(f"{name}.kbank"))
+    assert len(bank["clips"]) == (6 if name == "b41_runtime" else 7)
+    assert (bank["dictionary"] is not None) == (name == "b41_dictionary")
+    assert bank["runtime"] == (name == "b41_runtime")
+    for c in bank["clips"]:
+        clip_name = c["name"].decode()
+        assert rd.find_clip(bank, c["name"]) == c["index"]
+        if name == "b41_damaged" and clip_name == "v3_uniform":
+            with pytest.raises(rd.KanimError) as e:
+                rd.decode_member(bank, c["index"])
+            assert e.value.status == "checksum_mismatch" and e.value.clip == (c["index"], c["name"])
+            continue
+        clip = rd.decode_member(bank, c["index"])
+        text = rd.json_text(rd.expected_values(clip, f"{name}.kbank", clip_name))
+        assert json_less_names(text) == json_less_names((VECTORS / f"{clip_name}.json").read_text()), clip_name
