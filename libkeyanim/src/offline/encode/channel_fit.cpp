@@ -19,7 +19,7 @@ int64_t quantize(double y, double step) noexcept {
 void FitScratch::prepare(size_t frames) {
   if (prev.size() == frames) return;
   prev.assign(frames, CurveFit::kNone), next.assign(frames, CurveFit::kNone), is_key.assign(frames, 0);
-  q.assign(frames, 0), v.assign(frames, 0.0f), seg_ratio.assign(frames, 0.0), seg_arg.assign(frames, 0);
+  v.assign(frames, 0.0f), seg_ratio.assign(frames, 0.0), seg_arg.assign(frames, 0);
 }
 
 CurveFit::CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule,
@@ -79,8 +79,7 @@ void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double s
 }
 
 void CurveFit::quantize_at(uint32_t f) {
-  w_.q[f] = quantize(y_[f], step_);
-  w_.v[f] = dequantize(w_.q[f], step_);
+  w_.v[f] = dequantize(quantize(y_[f], step_), step_);
 }
 
 void CurveFit::measure_all() {

@@ -49,7 +49,6 @@ inline SegmentOperands operands_between(const Key* before, Key a, Key b, const K
 struct FitScratch {
   std::vector<uint32_t> prev, next;  // kNone at the ends, and for frames that are not keys
   std::vector<uint8_t> is_key;
-  std::vector<int64_t> q;
   std::vector<float> v;
   std::vector<double> seg_ratio;  // per segment, indexed by its start frame
   std::vector<uint32_t> seg_arg;
