@@ -36,8 +36,9 @@ FUZZ=(clang)
 FUZZ_RT=(libclang-rt-14-dev libclang-rt-dev)
 # The browser viewer (viewer/): node and npm build it (any source of node >= 18 will do: checked
 # as commands), chromium runs its browser tests (driven by puppeteer-core, which never downloads
-# a browser).
-VIEWER=(chromium)
+# a browser); zstd, the command-line tool, makes the reference frames (with a dictionary it
+# trains) that viewer/test/zstd.test.mjs decodes.
+VIEWER=(chromium zstd)
 
 installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }
 

@@ -1,9 +1,12 @@
 // The page: opening files (picker, drag and drop, embedded by `keyanim view`), playback, and
 // the panels. A .kanim is shown decoded, with its original BVH overlaid when one is opened; a
-// BVH opened alone is played by itself (its frames, nearest frame between them). Decoding is
+// bank (.kbank) lists its clips, and the one picked is shown as a .kanim is (a damaged one says
+// why, the others still play); a BVH opened alone is played by itself (its frames, nearest
+// frame between them). Decoding is
 // the keyanim-three package's (packages/keyanim-three/src/decoder/); drawing is view3d.js and
 // curves.js; what the camera follows and frames, framing.js; the up axis, upaxis.js.
 import { decodeKanim, looksLikeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
+import { openBank, decodeBankClip, looksLikeBank } from 'keyanim-three/decoder/bank.js';
 import { samplePose } from 'keyanim-three/decoder/sample.js';
 import { parseBvh } from './bvh.js';
 import { worldPositions, measuredPoints, measuredSettings, skeletonSize, largestDistance } from 'keyanim-three/decoder/pose.js';
@@ -19,16 +22,23 @@ export class App {
   constructor() {
     this.view = new View3D($('view'));
     this.curves = new CurvePanel($('curve'), $('curve-channel'), $('curve-span'));
-    Object.assign(this, { clip: null, original: null, originalName: '', position: 0, clock: 0, playing: false, lastTick: 0 });
+    Object.assign(this, { clip: null, original: null, originalName: '', bank: null, bankName: '', position: 0, clock: 0, playing: false, lastTick: 0 });
     this.bindControls();
     this.bindFiles();
   }
 
   // --- Opening files ---------------------------------------------------------------------
 
+  // A .kanim file: shown, and a bank's list (if one was open) put away.
   loadClip(bytes, name) {
+    this.showClip(() => decodeKanim(bytes), name);
+    this.closeBank();
+  }
+
+  // decode() gives the clip (decodeKanim's), or throws: then the clip shown stays.
+  showClip(decode, name) {
     try {
-      const clip = decodeKanim(bytes);
+      const clip = decode();
       if (clip.frameCount === 0) throw new Error('the clip has no frames');
       this.clip = clip;
       this.clipName = name;
@@ -60,6 +70,53 @@ export class App {
     }
   }
 
+  // A bank: its index is checked (no clip is read), its clips listed to pick from, and its
+  // first clip shown. A bad index throws; the clip shown before stays.
+  loadBank(bytes, name) {
+    let bank;
+    try {
+      bank = openBank(bytes);
+    } catch (e) {
+      this.error(`${name}: ${e.message}`);
+      throw e;
+    }
+    Object.assign(this, { bank, bankName: name, bankShown: -1 });
+    const list = $('bank-clips');
+    list.replaceChildren(...bank.clips.map((c) => {
+      const o = el('option', `${c.name} · ${c.frameCount} frames · ${c.duration.toFixed(3)} s`);
+      o.value = String(c.index);
+      return o;
+    }));
+    list.disabled = bank.clips.length === 0;
+    $('bank').hidden = false;
+    $('bank-count').textContent = `${bank.clips.length} clip${bank.clips.length === 1 ? '' : 's'}, ${bank.profile}${bank.dictionaryBytes ? ', dictionary' : ''}`;
+    if (bank.clips.length === 0) { this.message(`${name}: a bank without clips`); return; }
+    try { this.pickClip(0); } catch { /* shown by error(); the list offers the others */ }
+  }
+
+  // Shows clip i of the open bank. A damaged clip throws (shown by error()): it is marked in
+  // the list, and the list goes back to the clip still shown.
+  pickClip(i) {
+    if (!this.bank?.clips[i]) throw new RangeError(`no clip ${i} in ${this.bank ? this.bankName : 'a bank: none is open'}`);
+    const c = this.bank.clips[i], option = $('bank-clips').options[i];
+    try {
+      this.showClip(() => decodeBankClip(this.bank, i), `${this.bankName}:${c.name}`);
+      this.bankShown = i;
+      $('bank-clips').value = String(i);
+    } catch (e) {
+      option.classList.add('damaged');
+      if (!option.textContent.endsWith(' · damaged')) option.textContent += ' · damaged';
+      $('bank-clips').value = String(this.bankShown);
+      throw e;
+    }
+  }
+
+  closeBank() {
+    Object.assign(this, { bank: null, bankName: '' });
+    $('bank').hidden = true;
+    $('bank-clips').replaceChildren();
+  }
+
   // The same hierarchy and channel layout: nodes, parents and channel types, in order.
   matches(o) {
     const a = this.clip.nodes, b = o.nodes;
@@ -77,7 +134,8 @@ export class App {
     for (const file of [...files].sort((a, b) => isBvh(a) - isBvh(b))) {  // the clip first
       const bytes = new Uint8Array(await file.arrayBuffer());
       try {
-        if (looksLikeKanim(bytes)) this.loadClip(bytes, file.name);
+        if (looksLikeBank(bytes)) this.loadBank(bytes, file.name);
+        else if (looksLikeKanim(bytes)) this.loadClip(bytes, file.name);
         else this.loadOriginal(new TextDecoder().decode(bytes), file.name);
       } catch { /* shown by error() */ }
     }
@@ -251,6 +309,9 @@ export class App {
 
   bindFiles() {
     $('open').addEventListener('change', (e) => this.openFiles(e.target.files));
+    $('bank-clips').addEventListener('change', (e) => {
+      try { this.pickClip(Number(e.target.value)); } catch { /* shown by error() */ }
+    });
     window.addEventListener('dragover', (e) => { e.preventDefault(); document.body.classList.add('dragging'); });
     window.addEventListener('dragleave', () => document.body.classList.remove('dragging'));
     window.addEventListener('drop', (e) => {

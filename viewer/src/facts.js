@@ -2,12 +2,12 @@
 const fmt = (v, digits = 4) => Number(v.toPrecision(digits)).toLocaleString('en-US');
 const bytes = (n) => (n < 10240 ? `${n} B` : n < 10485760 ? `${fmt(n / 1024, 3)} KiB` : `${fmt(n / 1048576, 3)} MiB`);
 
-// clip: from decodeKanim; original: { name, bytes } of the BVH text, when loaded.
+// clip: from decodeKanim (or decodeBankClip: clip.bank = { name, index }); original: { name, bytes } of the BVH text, when loaded.
 export function clipFacts(clip, original) {
   const joints = clip.nodes.filter((n) => !n.endSite).length;
   const rawF32 = clip.frameCount * clip.channelCount * 4;
   const rows = [
-    ['format', `.kanim ${clip.version.major}.${clip.version.minor}, ${clip.profile} profile`],
+    ['format', `.kanim ${clip.version.major}.${clip.version.minor}, ${clip.profile} profile${clip.bank ? ", a bank's clip" : ''}`],
     ['frames', `${clip.frameCount}`],
     ['fps', clip.frameTime > 0 ? fmt(1 / clip.frameTime, 5) : '-'],
     ['duration', clip.frameTime > 0 ? `${fmt(Math.max(0, clip.frameCount - 1) * clip.frameTime, 4)} s` : '-'],
@@ -18,6 +18,7 @@ export function clipFacts(clip, original) {
     ['bytes', bytes(clip.fileBytes)],
     ['ratio', `${fmt(rawF32 / clip.fileBytes, 3)}x raw float32`],
   ];
+  if (clip.bank) rows.push(['in the bank', `clip ${clip.bank.index}: ${clip.bank.name} (bytes: the clip's own)`]);
   if (original) rows.push(['original', `${original.name}: ${bytes(original.bytes)} (${fmt(original.bytes / clip.fileBytes, 3)}x)`]);
   return rows;
 }

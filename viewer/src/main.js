@@ -8,13 +8,20 @@ const app = new App();
 app.loadEmbedded();
 
 // For tests and scripts: load(arrayBuffer) opens a .kanim (throws on a bad file),
-// loadOriginal(text) a BVH; sampleWorld(x) gives every node's world position [x, y, z] at
+// loadBank(arrayBuffer) a .kbank (throws on a bad index; lists its clips and shows clip 0,
+// or says why it does not decode), pickClip(i) shows the bank's clip i (throws on a damaged
+// one), bankClips lists the bank's clips ({ index, name, frameCount, duration }) and
+// bankShown the one shown; loadOriginal(text) a BVH; sampleWorld(x) gives every node's world position [x, y, z] at
 // frame position x, in node order (the order of `keyanim sample --world --json`); frameCount and
 // nodeNames are the clip's, or the BVH's when it is shown alone; inView(x) shows frame position
 // x and gives, per node of the figure shown, its normalized device coordinates through the
 // page's camera and whether it is a placeholder (framing.js).
 window.keyanim = {
   load(buffer, name = 'clip.kanim') { app.loadClip(new Uint8Array(buffer), name); },
+  loadBank(buffer, name = 'clips.kbank') { app.loadBank(new Uint8Array(buffer), name); },
+  pickClip(i) { app.pickClip(i); },
+  get bankClips() { return app.bank ? app.bank.clips.map(({ index, name, frameCount, duration }) => ({ index, name, frameCount, duration })) : []; },
+  get bankShown() { return app.bank ? app.bankShown : -1; },
   loadOriginal(text, name = 'original.bvh') { app.loadOriginal(text, name); },
   get frameCount() { return app.subject ? app.subject.frameCount : 0; },
   get nodeNames() { return app.subject ? app.subject.nodes.map((n) => n.name) : []; },

@@ -222,3 +222,70 @@ test('a z-up BVH is shown upright (up: auto detects z; y lays it down)', { skip 
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+// Issue 25: a bank opened with the file picker lists its clips (name, frames, duration, as
+// `keyanim list --json` has them); picking one in the list shows it, sampling as `keyanim sample
+// BANK:NAME --world --json`; a damaged clip says why when picked (its name, checksum_mismatch),
+// is marked in the list, and the clip shown before stays; the others still play.
+test('a .kbank lists its clips; picking one shows it; a damaged one says why, the others play', { skip }, async () => {
+  const input = path.join(dir, 'bank-in'), bank = path.join(dir, 'clips.kbank'), damaged = path.join(dir, 'damaged.kbank');
+  fs.mkdirSync(path.join(input, 'again'), { recursive: true });
+  for (const f of ['cmu_02_01_walk.bvh', 'cmu_131_03_hop.bvh']) fs.copyFileSync(path.join(sourceDir, 'data', f), path.join(input, f));
+  fs.copyFileSync(path.join(sourceDir, 'data/cmu_02_01_walk.bvh'), path.join(input, 'again/walk.bvh'));
+  cli('pack', input, '-o', bank, '--dictionary', 'on', '-q');
+  const listed = JSON.parse(cli('list', bank, '--json')).clips;
+  const bytes = fs.readFileSync(bank);
+  const hop = listed.findIndex((c) => c.name === 'cmu_131_03_hop');
+  const hopAt = Number(bytes.readBigUInt64LE(40 + 32 * 2 + 40 * hop));  // its clip-table Offset (spec 10.3)
+  bytes[hopAt + 200] ^= 0x08;  // inside the member: its own CRC-32 finds it, the bank's index is intact
+  fs.writeFileSync(damaged, bytes);
+
+  const { page, problems } = await open(pathToFileURL(viewerPage).href);
+  const expectSampled = async (file, name) => {
+    for (const x of [0, 10.5, 100.25]) {
+      const got = await page.evaluate((p) => window.keyanim.sampleWorld(p), x);
+      const want = JSON.parse(cli('sample', `${file}:${name}`, '--frame', String(x), '--world', '--json')).joints;
+      assert.equal(got.length, want.length);
+      want.forEach((j, i) => {
+        const d = Math.hypot(got[i][0] - j.position[0], got[i][1] - j.position[1], got[i][2] - j.position[2]);
+        if (!(d <= 1e-9 * 100)) assert.fail(`${name} frame ${x}, node ${j.name}: ${got[i]} vs ${j.position}`);
+      });
+    }
+  };
+  await (await page.$('#open')).uploadFile(bank);
+  await page.waitForFunction(() => window.keyanim.bankClips.length > 0 && document.body.classList.contains('loaded'), { timeout: 10000 });
+  assert.equal(await page.$eval('#bank', (e) => e.hidden), false);
+  const options = await page.$$eval('#bank-clips option', (os) => os.map((o) => o.textContent));
+  assert.deepEqual(options, listed.map((c) => `${c.name} · ${c.frames} frames · ${c.duration.toFixed(3)} s`));
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), listed[0].frames);
+  await expectSampled(bank, listed[0].name);
+  await page.select('#bank-clips', String(hop));
+  assert.equal(await page.evaluate(() => window.keyanim.bankShown), hop);
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), listed[hop].frames);
+  assert.match(await page.$eval('#message', (e) => e.textContent), new RegExp(`^clips\\.kbank:cmu_131_03_hop: ${listed[hop].frames} frames`));
+  await expectSampled(bank, 'cmu_131_03_hop');
+  await expectSkeletonsDrawn(page, false);
+
+  // The damaged bank: opens; its damaged clip is refused when picked, the others play.
+  await (await page.$('#open')).uploadFile(damaged);
+  await page.waitForFunction(() => window.keyanim.bankShown === 0 && document.getElementById('message').textContent.startsWith('damaged.kbank'), { timeout: 10000 });
+  const walkAgain = listed.findIndex((c) => c.name === 'again/walk');
+  await page.select('#bank-clips', String(walkAgain));
+  assert.equal(await page.evaluate(() => window.keyanim.bankShown), walkAgain);
+  await page.select('#bank-clips', String(hop));
+  const message = await page.$eval('#message', (e) => ({ text: e.textContent, error: e.className }));
+  assert.equal(message.error, 'error');
+  assert.match(message.text, /^damaged\.kbank:cmu_131_03_hop: clip "cmu_131_03_hop" \(#\d\): checksum, offset \d+ \(0x[0-9a-f]+\): checksum_mismatch: /);
+  assert.equal(await page.evaluate(() => window.keyanim.bankShown), walkAgain, 'the clip shown before stays');
+  assert.equal(await page.$eval('#bank-clips', (e) => e.value), String(walkAgain));
+  assert.match(await page.$eval(`#bank-clips option:nth-child(${hop + 1})`, (e) => e.textContent), / · damaged$/);
+  await expectSampled(damaged, 'again/walk');
+  await page.select('#bank-clips', '0');
+  assert.equal(await page.evaluate(() => window.keyanim.frameCount), listed[0].frames);
+  // A .kanim opened next puts the bank's list away.
+  await (await page.$('#open')).uploadFile(kanim);
+  await page.waitForFunction(() => window.keyanim.bankClips.length === 0, { timeout: 10000 });
+  assert.equal(await page.$eval('#bank', (e) => e.hidden), true);
+  assert.deepEqual(problems, []);
+  await page.close();
+});

@@ -71,6 +71,9 @@ const cases = {
   'IMAG not at table entry 1': { bytes: fixXxh(swapImagSkel()), status: 'corrupt', where: 'section table', offset: 24 + 24 },
   'a wrong XXH64': { bytes: patch((b) => { b[b.length - 1] ^= 1; }, false), status: 'checksum_mismatch', where: 'checksum', offset: base.length - 8 },
   // More of 9.1 and 9.4, and a content rule this decoder checks (First_Value of a block curve).
+  // 4.1 gives Header_Flags bits 1 (Member) and 2 (Bank) meanings (spec 10.2, 10.5); bit 3 stays reserved.
+  'Member set in a file by itself': { bytes: patch((b) => { b[12] |= 2; }), status: 'corrupt', where: 'header', offset: 12 },
+  'Header_Flags bit 3': { bytes: patch((b) => { b[12] |= 8; }), status: 'reserved_bits_set', where: 'header', offset: 12 },
   'Runtime set in a 3.0 file': { bytes: withCrc32(read('v3_rules.kanim'), (b) => { b[12] = 1; }), status: 'reserved_bits_set', where: 'header', offset: 12 },
   'Runtime clear: IMAG is an unknown critical section': { bytes: patch((b) => { b[12] = 0; }, false), status: 'reserved_bits_set', where: 'section table', offset: L.sections.IMAG.entry },
   // keyanim's C++ names the record's Value_Bits byte for either width; section 7 asks for the field's.

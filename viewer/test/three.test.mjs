@@ -2,12 +2,14 @@
 // two roots (the corpus clips: three_corpus.test.mjs): an AnimationMixer plays each clip and
 // its bones agree with the CLI (mixer-check.mjs says how); without the keys the loader adds,
 // three.js's in-betweens leave the tolerance; several roots come under a Group; a damaged file
-// throws the decoder's error; bad options are refused.
+// throws the decoder's error; bad options are refused; a bank's clip gives its own file's tracks.
 import { test, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { KanimLoader, KanimError, decodeKanim } from 'keyanim-three';
+import os from 'node:os';
+import { execFileSync } from 'node:child_process';
+import { KanimLoader, KanimError, decodeKanim, openBank, decodeBankClip } from 'keyanim-three';
 import { encode, player, worstAgainstCli, checkClip, removeScratch } from './mixer-check.mjs';
 import { keyanimCli, sourceDir, exists } from './paths.mjs';
 
@@ -80,4 +82,22 @@ test('setFrameRate and setTolerance reject what is not a number > 0', () => {
   for (const bad of [0, -1, NaN, Infinity, '30']) assert.throws(() => loader.setFrameRate(bad), RangeError);
   for (const bad of [0, -1, NaN]) assert.throws(() => loader.setTolerance(bad), RangeError);
   assert.equal(loader.setFrameRate(null).frameRate, null);
+});
+
+// A bank's clip through fromClip: the same tracks as its own file through parse.
+test('a bank clip (dictionary bank) through fromClip = its unpacked file through parse', { skip: noCli }, (t) => {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'keyanim-three-bank-'));
+  t.after(() => fs.rmSync(dir, { recursive: true, force: true }));
+  const bank = path.join(dir, 'b.kbank');
+  execFileSync(keyanimCli, ['pack', ...DATA_CLIPS.map((c) => path.join(sourceDir, c)), '-o', bank, '--dictionary', 'on', '-q']);
+  execFileSync(keyanimCli, ['unpack', bank, '-o', path.join(dir, 'out'), '-q']);
+  const opened = openBank(fs.readFileSync(bank));
+  assert.equal(opened.clips.length, 2);
+  for (const c of opened.clips) {
+    const fromBank = new KanimLoader().fromClip(decodeBankClip(opened, c.index), c.name);
+    const fromFile = new KanimLoader().parse(fs.readFileSync(path.join(dir, 'out', `${c.name}.kanim`)), c.name);
+    assert.equal(fromBank.skeleton.bones.length, fromFile.skeleton.bones.length);
+    assert.deepEqual(fromBank.clip.tracks.map((k) => [k.name, Array.from(k.times), Array.from(k.values)]),
+      fromFile.clip.tracks.map((k) => [k.name, Array.from(k.times), Array.from(k.values)]), c.name);
+  }
 });

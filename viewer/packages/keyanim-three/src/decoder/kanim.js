@@ -1,8 +1,9 @@
 // The .kanim decoder, written from spec/FORMAT.md alone: container (sections 1-3), the CLIP,
 // SKEL, CHAN, KTIM and NOTE sections (4), the checks of sections 5-8, in the order section 7
 // recommends. Archive files of versions 3.0 and 4.0 and, by Appendix E, 1.0 and 2.0; runtime
-// files of 4.0 (section 9: table rules in table-rules.js, IMAG in imag.js). Key values:
-// kval.js; sampling (Appendix A): sample.js.
+// files of 4.0 (section 9: table rules in table-rules.js, IMAG in imag.js); a bank's members
+// (section 10.5: decodeClip with the bank's skeleton and dictionary; banks: bank.js). Key
+// values: kval.js; sampling (Appendix A): sample.js.
 import { fail, KanimError } from './errors.js';
 import { SectionReader } from './reader.js';
 import { crc32 } from './crc32.js';
@@ -46,17 +47,32 @@ export function nodeLabel(nodes, i) {
 
 // Decodes and validates a whole file. Returns the clip (see makeClip) or throws KanimError.
 export function decodeKanim(input, limits = DEFAULT_LIMITS) {
-  const bytes = input instanceof Uint8Array ? input : new Uint8Array(input);
-  const { version, profile, sections } = readContainer(bytes, limits);
+  return decodeClip(input instanceof Uint8Array ? input : new Uint8Array(input), limits, null);
+}
+
+// A file by itself (member null) or a bank's member (spec 10.5; bank.js): member is { runtime,
+// skel: the bank's skeleton's content, skelOffset: where its stored bytes lie relative to the
+// member's first byte, skelCompressed, dictionary: readDictionary's, or null }.
+export function decodeClip(bytes, limits, member) {
+  const { version, profile, sections } = readContainer(bytes, limits, member);
   const clip = makeClip(version, profile, bytes.length, sections);
   const parsers = PARSERS[profile];
-  for (const s of sections) {
+  for (const s of withMemberSkeleton(sections, profile, member)) {
     const parse = parsers[s.tag];
     if (!parse) continue;  // an ancillary section of a later minor version
-    parse(new SectionReader(s.tag, sectionContent(bytes, s), s.offset, s.compressed), clip, limits);
+    parse(new SectionReader(s.tag, s.content ?? sectionContent(bytes, s, member?.dictionary), s.offset, s.compressed), clip, limits);
   }
   if (profile === 'runtime') nameChannels(clip);
   return clip;
+}
+
+// A member's skeleton is read as its SKEL (10.5.3), where SKEL would lie: after CLIP in the
+// archive profile (3.2.3), after IMAG in the runtime profile (9.1.1).
+function withMemberSkeleton(sections, profile, member) {
+  if (!member) return sections;
+  const at = profile === 'runtime' ? 2 : 1;
+  const skel = { tag: 'SKEL', content: member.skel, offset: member.skelOffset, compressed: member.skelCompressed };
+  return [...sections.slice(0, at), skel, ...sections.slice(at)];
 }
 
 // profile: 'archive' (sections 2-8) or 'runtime' (section 9); either gives the same clip.
@@ -71,7 +87,7 @@ function makeClip(version, profile, fileBytes, sections) {
 
 // --- Signature, header, section table, file length, raw-size limit, checksum ---------------
 
-function readContainer(bytes, limits) {
+function readContainer(bytes, limits, member) {
   for (let i = 0; i < 8; ++i) {
     if (i >= bytes.length) fail('truncated', 'signature', bytes.length, 'the file ends inside the signature');
     if (bytes[i] !== SIGNATURE[i]) fail('bad_signature', 'signature', i, 'not a .kanim file (wrong signature)');
@@ -81,8 +97,7 @@ function readContainer(bytes, limits) {
   const major = view.getUint16(8, true), minor = view.getUint16(10, true);
   if (major < 1 || major > 4) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 4)`);
   const flags = view.getUint32(12, true);
-  // Bit 0 is Runtime in version 4 (spec 2.2), reserved before; bits 1-15 are reserved.
-  if (flags & (major === 4 ? 0xfffe : 0xffff)) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  checkHeaderFlags(major, flags, member);
   const profile = major === 4 && (flags & 1) ? 'runtime' : 'archive';
   const checksumBytes = profile === 'runtime' ? 8 : 4;  // XXH64 (9.1.3) or CRC-32 (3.3)
   const count = view.getUint32(16, true);
@@ -91,9 +106,11 @@ function readContainer(bytes, limits) {
   if (bytes.length < tableEnd) fail('truncated', 'section table', bytes.length, `the file ends inside the table of ${count} sections`);
 
   const parsers = PARSERS[profile];
-  const sections = readTable(bytes, view, count, profile === 'runtime' ? runtimeRules() : archiveRules(), checksumBytes);
+  const rules = profile === 'runtime' ? runtimeRules(!!member) : archiveRules(!!member);
+  const sections = readTable(bytes, view, count, rules, checksumBytes);
   checkLength(bytes.length, tableEnd, sections, checksumBytes);
-  let raw = 0n;
+  let raw = member ? BigInt(member.skel.length) : 0n;  // a member's skeleton counts as its SKEL (10.5.3)
+  if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', 24, `the bank's skeleton of ${raw} bytes is above the limit of ${limits.rawBytes}`);
   for (const s of sections) {
     if (parsers[s.tag]) raw += s.rawSize;
     if (raw > BigInt(limits.rawBytes)) fail('limit_exceeded', 'section table', s.entry + 16, `the sections decode to ${raw} bytes or more, above the limit of ${limits.rawBytes}`);
@@ -105,6 +122,17 @@ function readContainer(bytes, limits) {
   });
   checkChecksum(bytes, view, profile);
   return { version: { major, minor }, profile, sections };
+}
+
+// Bit 0 Runtime in version 4 (spec 2.2); bit 1 Member and bit 2 Bank from 4.1 on (10.2, 10.5):
+// a member only in its bank, a bank never as a clip; bits 3-15 reserved (0-15 before 4).
+function checkHeaderFlags(major, flags, member) {
+  if (flags & (major === 4 ? 0xfff8 : 0xffff)) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  if (major !== 4) return;
+  if (!member && flags & 4) fail('invalid_argument', 'header', 12, 'a bank of many clips (spec section 10), not a clip: open it as a bank (openBank)');
+  if (!member && flags & 2) fail('corrupt', 'header', 12, "a bank's member (Header_Flags bit 1), which only its bank reads");
+  if (member && (!(flags & 2) || flags & 4)) fail('corrupt', 'header', 12, "a bank's clip must have Header_Flags bit 1 (Member) set and bit 2 (Bank) clear");
+  if (member && (flags & 1) !== (member.runtime ? 1 : 0)) fail('corrupt', 'header', 12, "a bank's clips are of the bank's profile (Header_Flags bit 0)");
 }
 
 const hex = (v, digits) => v.toString(16).padStart(digits, '0');
@@ -155,11 +183,11 @@ function checkLength(length, tableEnd, sections, checksumBytes) {
   for (const s of sections) s.offset = Number(s.offset);
 }
 
-function sectionContent(bytes, s) {
+function sectionContent(bytes, s, dictionary) {
   const stored = bytes.subarray(s.offset, s.offset + Number(s.storedSize));
   if (!s.compressed) return stored;
   try {
-    return decompressSection(stored, Number(s.rawSize));
+    return decompressSection(stored, Number(s.rawSize), dictionary ?? null);
   } catch (e) {
     if (isZstdFailure(e)) fail('zstd_error', `section ${s.tag}`, s.offset, e.message);
     throw e;

@@ -1,11 +1,17 @@
 // What each profile allows in the section table: rules 3.2.2 and 3.2.3 (archive) and 9.1.1
 // (runtime). Each returns { entry(e), end() }, called per table entry (e: index, tag,
 // compressed, ancillary, entry = the entry's file offset, where = its name for messages) and
-// once after the last; they throw KanimError.
+// once after the last; they throw KanimError. `member`: the table of a bank's member, which
+// holds no SKEL (spec 10.5.2: its skeleton is the bank's).
 import { fail } from './errors.js';
 
 const ARCHIVE_CRITICAL = ['CLIP', 'SKEL', 'CHAN', 'KTIM', 'KVAL'];
 const RUNTIME_SECTIONS = ['CLIP', 'IMAG', 'SKEL'];
+const withoutSkel = (tags) => tags.filter((t) => t !== 'SKEL');
+
+function refuseMemberSkel(e) {
+  if (e.tag === 'SKEL') fail('corrupt', 'section table', e.entry, `${e.where}: a bank's member holds no SKEL (its skeleton is the bank's)`);
+}
 
 // NOTE: at most once, ancillary (3.2.3; 9.1.2 keeps it in the runtime profile).
 function checkNote(e, seen) {
@@ -13,14 +19,16 @@ function checkNote(e, seen) {
   if (seen) fail('corrupt', 'section table', e.entry, `${e.where}: a second NOTE section`);
 }
 
-export function archiveRules() {
+export function archiveRules(member = false) {
+  const CRITICAL = member ? withoutSkel(ARCHIVE_CRITICAL) : ARCHIVE_CRITICAL;
   let nextCritical = 0, notes = 0;
   return {
     entry(e) {
-      const critical = ARCHIVE_CRITICAL.indexOf(e.tag);
+      if (member) refuseMemberSkel(e);
+      const critical = CRITICAL.indexOf(e.tag);
       if (critical >= 0) {
         if (e.ancillary) fail('corrupt', 'section table', e.entry + 4, `${e.where}: ${e.tag} must be critical (Ancillary clear)`);
-        if (critical !== nextCritical) fail('corrupt', 'section table', e.entry, `${e.where}: ${nextCritical < ARCHIVE_CRITICAL.length ? `expected ${ARCHIVE_CRITICAL[nextCritical]}` : `${e.tag} again`} (the critical sections come once each, in the order ${ARCHIVE_CRITICAL.join(', ')})`);
+        if (critical !== nextCritical) fail('corrupt', 'section table', e.entry, `${e.where}: ${nextCritical < CRITICAL.length ? `expected ${CRITICAL[nextCritical]}` : `${e.tag} again`} (the critical sections come once each, in the order ${CRITICAL.join(', ')})`);
         ++nextCritical;
       } else if (e.tag === 'NOTE') {
         checkNote(e, notes++ > 0);
@@ -29,25 +37,27 @@ export function archiveRules() {
       }
     },
     end() {
-      if (nextCritical < ARCHIVE_CRITICAL.length) fail('corrupt', 'section table', 24, `no ${ARCHIVE_CRITICAL[nextCritical]} section`);
+      if (nextCritical < CRITICAL.length) fail('corrupt', 'section table', 24, `no ${CRITICAL[nextCritical]} section`);
     },
   };
 }
 
 // 9.1.1: CLIP, IMAG, SKEL at entries 0, 1, 2; after them at most one NOTE and unknown
 // ancillary sections, in any order; nothing compressed; no section of the archive profile.
-export function runtimeRules() {
+export function runtimeRules(member = false) {
+  const SECTIONS = member ? withoutSkel(RUNTIME_SECTIONS) : RUNTIME_SECTIONS;
   let count = 0, notes = 0;
   return {
     entry(e) {
       ++count;
+      if (member) refuseMemberSkel(e);
       if (e.compressed) fail('corrupt', 'section table', e.entry + 4, `${e.where}: no section of the runtime profile is compressed`);
       if (ARCHIVE_CRITICAL.includes(e.tag) && !RUNTIME_SECTIONS.includes(e.tag)) fail('corrupt', 'section table', e.entry, `${e.where}: the runtime profile holds no ${e.tag}`);
-      if (e.index < RUNTIME_SECTIONS.length) {
-        const want = RUNTIME_SECTIONS[e.index];
-        if (e.tag !== want) fail('corrupt', 'section table', e.entry, `${e.where}: expected ${want} (the runtime profile's sections are CLIP, IMAG, SKEL at entries 0 to 2, then NOTE or not)`);
+      if (e.index < SECTIONS.length) {
+        const want = SECTIONS[e.index];
+        if (e.tag !== want) fail('corrupt', 'section table', e.entry, `${e.where}: expected ${want} (the runtime profile's sections are ${SECTIONS.join(', ')} at entries 0 to ${SECTIONS.length - 1}, then NOTE or not)`);
         if (e.ancillary) fail('corrupt', 'section table', e.entry + 4, `${e.where}: ${e.tag} must be critical (Ancillary clear)`);
-      } else if (RUNTIME_SECTIONS.includes(e.tag)) {
+      } else if (SECTIONS.includes(e.tag)) {
         fail('corrupt', 'section table', e.entry, `${e.where}: ${e.tag} again`);
       } else if (e.tag === 'NOTE') {
         checkNote(e, notes++ > 0);
@@ -56,7 +66,7 @@ export function runtimeRules() {
       }
     },
     end() {
-      if (count < RUNTIME_SECTIONS.length) fail('corrupt', 'section table', 24, `no ${RUNTIME_SECTIONS[count]} section`);
+      if (count < SECTIONS.length) fail('corrupt', 'section table', 24, `no ${SECTIONS[count]} section`);
     },
   };
 }

@@ -1,16 +1,18 @@
 // A compressed section (spec 3.2 rule 5): exactly one zstd frame (RFC 8878) that declares its
 // content size, equal to Raw_Size, and decompresses to exactly that with nothing left over.
 // The frame's structure is checked here, before anything is allocated; the blocks are then
-// decoded by fzstd. Failures throw { detail } for the caller to report as zstd_error.
+// decoded by fzstd, or, for a frame made with a bank's dictionary (spec 10.4), which fzstd does
+// not support, by zstd-blocks.js. Failures throw a ZstdFailure for the caller to report as
+// zstd_error.
 import { Decompress } from 'fzstd';
 import { xxh64Low32 } from './xxh64.js';
+import { bad, isZstdFailure } from './zstd-failure.js';
+import { decodeBlocks } from './zstd-blocks.js';
+
+export { isZstdFailure };
 
 const MAGIC = 0xfd2fb528;
 const BLOCK_MAX = 128 * 1024;
-
-class ZstdFailure extends Error {}
-const bad = (detail) => { throw new ZstdFailure(detail); };
-export const isZstdFailure = (e) => e instanceof ZstdFailure;
 
 function readLE(bytes, at, n) {
   let v = 0;
@@ -82,10 +84,11 @@ function singleSegmentFrame(frame, blocksStart, size, checksum) {
 }
 
 // The raw content of a section stored compressed: `rawSize` bytes, or a ZstdFailure.
-export function decompressSection(frame, rawSize) {
+// `dictionary`: a bank's (readDictionary of zstd-blocks.js), or null.
+export function decompressSection(frame, rawSize, dictionary = null) {
   const h = readFrameHeader(frame);
   if (h.contentSize !== rawSize) bad(`the zstd frame declares ${h.contentSize} bytes, Raw_Size is ${rawSize}`);
-  if (h.dictId !== 0) bad(`the zstd frame needs dictionary ${h.dictId}`);
+  if (h.dictId !== 0 && h.dictId !== dictionary?.id) bad(`the zstd frame needs dictionary ${h.dictId}${dictionary ? `, the bank's is ${dictionary.id}` : ''}`);
   const blockMax = Math.min(BLOCK_MAX, h.windowSize);
   const { end, bound } = walkBlocks(frame, h.blocksStart, blockMax);
   const frameEnd = end + 4 * h.checksum;
@@ -94,6 +97,25 @@ export function decompressSection(frame, rawSize) {
   if (bound < rawSize) bad(`the zstd frame's blocks cannot produce ${rawSize} bytes (at most ${bound})`);
 
   const out = new Uint8Array(rawSize);
+  const filled = dictionary ? withDictionary(frame, h, out, dictionary) : inflate(frame, h, out);
+  if (filled !== rawSize) bad(`the zstd frame decompresses to ${filled} bytes, not ${rawSize}`);
+  if (h.checksum && xxh64Low32(out) !== readLE(frame, end, 4)) bad('the zstd frame checksum does not match');
+  return out;
+}
+
+// zstd-blocks.js's decoding of the blocks into out; returns the bytes made.
+function withDictionary(frame, h, out, dictionary) {
+  try {
+    return decodeBlocks(frame, h.blocksStart, out, dictionary);
+  } catch (e) {
+    if (isZstdFailure(e)) throw e;
+    bad(`zstd cannot decompress the frame (${e.message})`);
+  }
+}
+
+// fzstd's decoding of the blocks into out; returns the bytes made.
+function inflate(frame, h, out) {
+  const rawSize = out.length;
   let filled = 0;
   const sink = new Decompress((chunk) => {
     if (chunk.length > rawSize - filled) bad(`the zstd frame decompresses to more than ${rawSize} bytes`);
@@ -106,7 +128,5 @@ export function decompressSection(frame, rawSize) {
     if (isZstdFailure(e)) throw e;
     bad(`zstd cannot decompress the frame (${e.message})`);
   }
-  if (filled !== rawSize) bad(`the zstd frame decompresses to ${filled} bytes, not ${rawSize}`);
-  if (h.checksum && xxh64Low32(out) !== readLE(frame, end, 4)) bad('the zstd frame checksum does not match');
-  return out;
+  return filled;
 }

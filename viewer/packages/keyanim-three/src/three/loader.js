@@ -78,7 +78,11 @@ export class KanimLoader extends Loader {
   // buffer: the file's bytes (ArrayBuffer or Uint8Array). Throws the decoder's KanimError
   // (status, where, offset) on a damaged file.
   parse(buffer, name = 'kanim') {
-    const kanim = decodeKanim(buffer);
+    return this.fromClip(decodeKanim(buffer), name);
+  }
+
+  // A clip decoded already: decodeKanim's, or a bank's (decodeBankClip of decoder/bank.js).
+  fromClip(kanim, name = 'kanim') {
     const { bones, root, skeleton } = buildSkeleton(kanim.nodes);
     const budget = this.tolerance ?? 0.5 * (clipTolerance(kanim) ?? DEFAULT_TOLERANCE * skeletonSize(kanim.nodes));
     const keys = sampleKeys(kanim, frameGrid(kanim, this.frameRate), budget);
