@@ -22,7 +22,7 @@ REQUIRED=(
   bash-completion  # tab completion of the installed tool (tools/completion/keyanim)
   parallel procps  # tests/cli/manifest_test.sh runs the README's GNU parallel recipe (and kills it)
   libxxhash-dev python3-xxhash  # the runtime profile's checksum, XXH64 (spec/FORMAT.md section 9)
-  zstd             # python/tests/test_reference_bank.py: the zstd program trains and applies a bank dictionary
+  zstd             # the zstd program trains and applies bank dictionaries: python/tests/test_reference_bank.py, viewer/test/zstd.test.mjs
   locales          # python/tests/test_hostile.py compiles de_DE.UTF-8 (localedef) into its own directory
   # The Python module (python/): pybind11 and numpy from Debian (no pip), pytest for its tests,
   # matplotlib for examples/plot_channel.py.
@@ -36,9 +36,8 @@ FUZZ=(clang)
 FUZZ_RT=(libclang-rt-14-dev libclang-rt-dev)
 # The browser viewer (viewer/): node and npm build it (any source of node >= 18 will do: checked
 # as commands), chromium runs its browser tests (driven by puppeteer-core, which never downloads
-# a browser); zstd, the command-line tool, makes the reference frames (with a dictionary it
-# trains) that viewer/test/zstd.test.mjs decodes.
-VIEWER=(chromium zstd)
+# a browser). viewer/test/zstd.test.mjs also uses the zstd program, which REQUIRED installs.
+VIEWER=(chromium)
 
 installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }
 
