@@ -357,7 +357,16 @@ TEST_CASE("a member's own rules (10.5)") {
   ErrorInfo err;
   CHECK(bank.clip(0, clip, &err) == Status::corrupt);
   CHECK(err.section.find("walk/start") != std::string::npos);
+  CHECK(err.byte_offset == l.clip(0) + 24);  // the field itself (spec section 7's offsets)
   CHECK(bank.clip(1, clip) == Status::ok);
+  // Frame_Time likewise, at its own offset.
+  b = good;
+  b[l.clip(1) + 16] ^= 0x01;
+  fix_checksum(b);
+  REQUIRE(Bank::open(b, bank) == Status::ok);
+  CHECK(bank.clip(1, clip, &err) == Status::corrupt);
+  CHECK(err.byte_offset == l.clip(1) + 16);
+  CHECK(err.detail.find("Frame_Time") != std::string::npos);
   CHECK(bank.clip(4, clip) == Status::invalid_argument);
   // The bank says the runtime profile, its members the archive's.
   b = good;

@@ -173,6 +173,31 @@ std::optional<uint32_t> Bank::find(std::string_view name) const noexcept {
   return std::nullopt;
 }
 
+
+namespace {
+// The index's Frame_Count and Frame_Time must be the member's CLIP (section 10.3), field by field, so
+// that a reader listing the bank and a reader decoding a clip agree; each mismatch names its field.
+Status check_entry_timing(const internal::BankIndex& idx, uint32_t i, Clip& out, ErrorInfo* err) {
+  const BankEntry e = idx.entry(i);
+  const uint64_t entry = uint64_t(idx.clip_at(i) - idx.bytes.data());
+  const double frame_time = out.frame_time();
+  uint64_t at = 0;
+  const char* what = nullptr;
+  if (out.frame_count() != e.frame_count) {
+    at = entry + 24;
+    what = "Frame_Count differs from the clip's CLIP";
+  } else if (std::memcmp(&e.frame_time, &frame_time, sizeof(double)) != 0) {
+    at = entry + 16;
+    what = "Frame_Time differs from the clip's CLIP";
+  } else {
+    return Status::ok;
+  }
+  if (err != nullptr) *err = ErrorInfo{Status::corrupt, at, "clip table", what};
+  out = Clip{};
+  return Status::corrupt;
+}
+}  // namespace
+
 Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& limits) const {
   out = Clip{};
   if (err != nullptr) *err = ErrorInfo{};
@@ -194,15 +219,7 @@ Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& lim
   if (s == Status::ok)
     s = internal::load_member(idx.bytes.subspan(e.offset, e.size), m, state_->storage ? state_ : nullptr, limits,
                                    &state_->rigs, out, err);
-  const double frame_time = out.frame_time();
-  if (s == Status::ok &&
-      (out.frame_count() != e.frame_count || std::memcmp(&e.frame_time, &frame_time, sizeof(double)) != 0)) {
-    if (err != nullptr)
-      *err = ErrorInfo{Status::corrupt, idx.layout.clip_table + uint64_t(i) * internal::kBankClipEntrySize + 16, "clip table",
-                       "Frame_Count or Frame_Time differs from the clip's CLIP"};
-    out = Clip{};
-    s = Status::corrupt;
-  }
+  if (s == Status::ok) s = check_entry_timing(idx, i, out, err);
   if (s != Status::ok && err != nullptr) err->section = "clip " + std::string(e.name) + " (" + std::to_string(i) + "), " + err->section;
   return s;
 }
