@@ -2,10 +2,6 @@
 // dictionary ready for zstd, and one rig cache, so that clips of one skeleton share a rig.
 #include "keyanim/bank.h"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zstd.h>
 #include <zstd_errors.h>
 
@@ -13,6 +9,7 @@
 #include <new>
 #include <vector>
 
+#include "runtime/bank/bank_file.h"
 #include "runtime/bank/bank_index.h"
 #include "runtime/load/member.h"
 
@@ -61,15 +58,6 @@ Status dictionary_refused(std::span<const uint8_t> dict, uint64_t offset, ErrorI
   return Status::corrupt;
 }
 
-// A read-only mapping of a whole file, unmapped with its last user.
-struct Mapping {
-  void* at = nullptr;
-  size_t size = 0;
-  ~Mapping() {
-    if (at != nullptr) ::munmap(at, size);
-  }
-};
-
 }  // namespace
 
 Status Bank::make(std::span<const uint8_t> bytes, std::shared_ptr<const void> storage, Bank& out, ErrorInfo* err) {
@@ -117,36 +105,11 @@ Status Bank::open(std::span<const uint8_t> bytes, Bank& out, ErrorInfo* err) {
 
 Status Bank::open_file(const std::string& path, Bank& out, ErrorInfo* err) {
   out = Bank{};
-  auto io_fail = [&](const char* what) {
-    if (err != nullptr) *err = ErrorInfo{Status::io_error, 0, "file", path + ": " + what + ": " + std::strerror(errno)};
-    return Status::io_error;
-  };
-  // O_NONBLOCK: a FIFO's open would wait for a writer; it is then refused as not a regular
-  // file (the flag changes nothing for a regular file, which is mapped, not read).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return io_fail("cannot open");
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    errno = errno == 0 ? EINVAL : errno;
-    return io_fail("not a regular file");
-  }
   try {
-    auto map = std::make_shared<Mapping>();
-    map->size = static_cast<size_t>(st.st_size);
-    if (map->size > 0) {
-      void* at = ::mmap(nullptr, map->size, PROT_READ, MAP_PRIVATE, fd, 0);
-      if (at == MAP_FAILED) {
-        ::close(fd);
-        return io_fail("cannot map");
-      }
-      map->at = at;
-    }
-    ::close(fd);
-    const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(map->at), map->size);  // page-aligned
-    return make(bytes, std::move(map), out, err);
+    internal::BankFile file;
+    if (Status s = internal::map_bank_file(path, file, err); s != Status::ok) return s;
+    return make(file.bytes, std::move(file.storage), out, err);
   } catch (const std::bad_alloc&) {
-    ::close(fd);
     return out_of_memory(err);
   }
 }
