@@ -100,5 +100,44 @@ PY
   expect_rc 2 "$K" list badi.kbank
   grep -q 'badi.kbank: section skeleton table, offset 48' .stderr || die "a damaged index: $(cat .stderr)"
   ;;
+manifest)
+  # encode --manifest --bank: each shard one bank, clips named as the files a run without --bank
+  # writes below OUTDIR (without .kanim); pack merges the shards; a failed input is reported,
+  # left out, and the exit code says so.
+  printf 'not a bvh\n' >lib/bad.bvh
+  printf 'lib/hop.bvh\nlib/cmu/walk.bvh\nlib/bad.bvh\n' >list.txt
+  expect_rc 2 "$K" encode --manifest list.txt -o s0.kbank --bank --shard 0/2 --report r.jsonl  # hop, bad
+  grep -q 'lib/bad.bvh:1:1' .stderr || die "the failed input: $(cat .stderr)"
+  expect_rc 0 "$K" encode --manifest list.txt -o s1.kbank --bank --shard 1/2 --report r.jsonl  # walk
+  [ "$("$K" list s0.kbank --json | json '[c["name"] for c in d["clips"]]')" = "['lib/hop']" ] || die "shard 0's bank"
+  [ "$(json '[(l["output"], l["status"]) for l in d]' < <(python3 -c "import json,sys; print(json.dumps([json.loads(x) for x in open('r.jsonl')]))"))" = \
+    "[('s0.kbank:lib/bad', 'failed'), ('s0.kbank:lib/hop', 'ok'), ('s1.kbank:lib/cmu/walk', 'ok')]" ] || die "report: $(cat r.jsonl)"
+  expect_rc 0 "$K" pack s0.kbank s1.kbank -o all.kbank
+  expect_rc 2 "$K" encode --manifest list.txt -o files  # the same inputs as files (lib/bad.bvh fails)
+  [ -f files/lib/hop.kanim ] && [ -f files/lib/cmu/walk.kanim ] || die "the run without --bank wrote: $(find files)"
+  expect_rc 0 "$K" unpack all.kbank -o un
+  for c in lib/hop lib/cmu/walk; do
+    expect_rc 0 "$K" -f decode "un/$c.kanim" -o u.bvh
+    expect_rc 0 "$K" -f decode "files/$c.kanim" -o f.bvh
+    cmp -s u.bvh f.bvh || die "$c from the banks decodes otherwise than its file"
+  done
+  # Resumed with --skip-existing: a bank holding the shard's clips is kept (without the option,
+  # refused); a bank short of one (shard 0 lost lib/bad) is encoded again, and replaced.
+  before=$(stat -c %i s1.kbank)
+  expect_rc 0 "$K" encode --manifest list.txt -o s1.kbank --bank --shard 1/2 --skip-existing
+  [ "$(stat -c %i s1.kbank)" = "$before" ] || die "--skip-existing rewrote a finished shard"
+  expect_rc 4 "$K" encode --manifest list.txt -o s1.kbank --bank --shard 1/2
+  before=$(stat -c %i s0.kbank)
+  expect_rc 2 "$K" encode --manifest list.txt -o s0.kbank --bank --shard 0/2 --skip-existing
+  [ "$(stat -c %i s0.kbank)" != "$before" ] || die "--skip-existing kept a bank short of a clip"
+  expect_rc 1 "$K" encode --manifest list.txt -o s0.kanim --bank  # a bank's name says .kbank
+  expect_rc 1 "$K" encode lib/hop.bvh --bank
+  grep -q -- '--bank goes with --manifest' .stderr || die "--bank without --manifest: $(cat .stderr)"
+  # Two entries of one clip name are refused before any work, in every shard.
+  cp lib/hop.bvh lib/hop.BVH
+  printf 'lib/hop.bvh\nlib/hop.BVH\n' >twice.txt
+  expect_rc 2 "$K" encode --manifest twice.txt -o t.kbank --bank --shard 1/2
+  grep -q "would be named 'lib/hop'" .stderr && [ ! -e t.kbank ] || die "two entries of one name: $(cat .stderr)"
+  ;;
 *) die "unknown case $CASE" ;;
 esac

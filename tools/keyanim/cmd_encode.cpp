@@ -24,7 +24,7 @@ namespace keyanim::cli {
 const char* const kEncodeHelp =
     "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--to kanim] [--error E|E%] [--shell D|D%]\n"
     "                      [--keys MODE] [--tension T|fit] [--level N] [--runtime] [-j N] [--json] [-f]\n"
-    "  or:  keyanim encode --manifest LIST -o OUTDIR [--shard I/N] [--skip-existing]\n"
+    "  or:  keyanim encode --manifest LIST -o OUTDIR|LIB.kbank [--bank] [--shard I/N] [--skip-existing]\n"
     "                      [--report R.jsonl] [--error E|E%] [--shell D|D%] [--keys MODE] [-j N] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode): every joint,\n"
     "End Site and shell point (--shell) stays within --error of the original.\n"
@@ -41,7 +41,11 @@ const char* const kEncodeHelp =
     "  --manifest LIST       encode every path listed (one per line; '-': standard input) to the\n"
     "                        same path below OUTDIR, as .kanim (an absolute path loses its root)\n"
     "  --shard I/N           only entries I, I+N, I+2N, ... (0 <= I < N): N machines, no coordination\n"
-    "  --skip-existing       skip an input whose output exists and loads as a valid file\n"
+    "  --bank                write the shard's clips into one bank, -o LIB.kbank, named as their\n"
+    "                        files below OUTDIR would be, without .kanim (`keyanim pack` merges\n"
+    "                        the shards' banks)\n"
+    "  --skip-existing       skip an input whose output exists and loads as a valid file (with\n"
+    "                        --bank: keep a bank that holds the shard's clips)\n"
     "  --report R.jsonl      append one JSON line per finished input: input, output, status\n"
     "                        (ok, skipped, failed), bytes, max_error, tolerance, seconds\n"
     "  --runtime             write the runtime profile (format 4.0): the image a player samples\n"
@@ -170,7 +174,7 @@ int cmd_encode(const Argv& argv, Globals& g) {
   if (to_kanim && (args.has("--manifest") || directory))
     fail(kUsage, "--to names the format of one output file; a directory or manifest run names each output .kanim");
   if (args.has("--manifest")) return encode_manifest(args, encode_settings(args), g);
-  for (const char* o : {"--shard", "--report", "--skip-existing"})
+  for (const char* o : {"--shard", "--report", "--skip-existing", "--bank"})
     if (args.has(o)) fail(kUsage, std::string(o) + " goes with --manifest LIST");
   if (args.positional().size() != 1) fail(kUsage, "encode takes one input file or directory");
   offline::EncodeSettings settings = encode_settings(args);

@@ -33,7 +33,7 @@ nlohmann::json bank_json(const std::string& path, const Bank& bank) {
 
 void print_table(const std::string& path, const Bank& bank) {
   std::cout << printable(path) << ": " << (bank.runtime_profile() ? "runtime" : "archive") << " bank, "
-            << bank.clip_count() << " clips, " << bank.skeleton_count() << " skeletons, " << bank.size_bytes()
+            << bank.clip_count() << " clips, " << bank.skeleton_count() << (bank.skeleton_count() == 1 ? " skeleton, " : " skeletons, ") << bank.size_bytes()
             << " bytes, " << (bank.dictionary_bytes() ? "a dictionary of " + std::to_string(bank.dictionary_bytes()) + " bytes" : "no dictionary")
             << "\n";
   char line[96];

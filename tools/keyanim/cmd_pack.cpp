@@ -10,6 +10,7 @@
 #include "batch.h"
 #include "commands.h"
 #include "escape.h"
+#include "formats.h"
 #include "io.h"
 #include "keyanim/offline/bank.h"
 #include "keyanim/offline/container.h"
@@ -173,7 +174,7 @@ int cmd_pack(const Argv& argv, Globals& g) {
   std::vector<FileId> ids;
   for (const Source& s : in)
     if (const auto id = input_id(s.path)) ids.push_back(*id);
-  Output output(out, true, g, ids, {"a bank", {".kbank"}, "", false, ""});
+  Output output(out, true, g, ids, bank_format());
   const std::vector<std::string> names = read_names(in, g);
   const std::vector<offline::BankInput> clips = clips_of(in, names, settings, g);
   const offline::WrittenBank w = or_fail(kBadInput, out + ": ", [&] { return offline::write_bank(clips, options); });

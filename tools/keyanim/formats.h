@@ -18,6 +18,7 @@ inline OutputFormat svg_format(bool stated, bool to_option = true) {
   return {"SVG", {".svg"}, to_option ? "--to svg" : "", stated, ""};
 }
 inline OutputFormat html_format(bool stated) { return {"an HTML page", {".html", ".htm"}, "--to html", stated, ""}; }
+inline OutputFormat bank_format() { return {"a bank", {".kbank"}, "", false, ""}; }
 inline OutputFormat json_lines_format() { return {"JSON lines", {".jsonl", ".ndjson", ".json"}, "", false, ""}; }
 
 // --to of a command that writes one format, `name`: stated when given, a usage error if it

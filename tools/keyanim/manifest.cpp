@@ -22,6 +22,8 @@
 #include "escape.h"
 #include "formats.h"
 #include "io.h"
+#include "manifest_bank.h"
+#include "manifest_report.h"
 #include "tally.h"
 #include "keyanim/clip.h"
 
@@ -73,52 +75,6 @@ std::string mirrored_output(const std::string& input, const std::string& outdir)
 
 namespace {
 
-// The report: one JSON line per finished input, each appended by a single write() to a file
-// opened with O_APPEND, so that lines from several processes never interleave (on a local
-// file system; on NFS give each process its own report).
-class Report {
- public:
-  explicit Report(const std::string& path) : path_(path) {
-    if (path.empty()) return;
-    std::error_code ec;  // in OUTDIR, say, not made yet
-    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path(), ec);
-    fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
-    if (fd_ < 0) fail(kOutputFailed, path + ": cannot open the report: " + std::strerror(errno));
-  }
-  ~Report() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  void add(const nlohmann::json& line) {
-    if (fd_ < 0) return;
-    const std::string text = json_text(line) + "\n";  // a name that is not UTF-8 keeps its line
-    std::lock_guard<std::mutex> lock(mutex_);
-    const ssize_t n = ::write(fd_, text.data(), text.size());
-    if (n != ssize_t(text.size())) fail(kOutputFailed, path_ + ": cannot append to the report: " + std::strerror(errno));
-  }
-
- private:
-  std::string path_;
-  int fd_ = -1;
-  std::mutex mutex_;
-};
-
-// Inputs already in the report as done (ok or skipped): a resumed run does not list them again.
-// Only a regular file is read back: a device or a FIFO (--report /dev/stdout) holds no earlier
-// run, and /dev/zero would be read without end.
-std::set<std::string> reported_done(const std::string& path) {
-  std::set<std::string> done;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return done;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) {
-    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);  // a torn last line is skipped
-    if (j.is_object() && j.contains("input") && j["input"].is_string() &&
-        (j.value("status", "") == "ok" || j.value("status", "") == "skipped"))
-      done.insert(j["input"].get<std::string>());
-  }
-  return done;
-}
-
 // The max_error= line of an existing output's notes, or null.
 nlohmann::json noted_error(const Clip& clip) {
   const std::string& notes = clip.encoder_notes();
@@ -164,27 +120,11 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
-
-int encode_manifest(const Args& args, const offline::EncodeSettings& settings, Globals& g) {
-  if (!args.positional().empty()) fail(kUsage, "encode --manifest takes no input file: the list names them");
-  const std::string list = *args.get("--manifest");
-  const std::string outdir = args.get("-o").value_or(args.get("--output").value_or(""));
-  if (outdir.empty() || outdir == "-") fail(kUsage, "encode --manifest needs -o OUTDIR");
-  const Shard shard = parse_shard(args.get("--shard").value_or("0/1"));
+// Each input to its own .kanim below `outdir`.
+int encode_shard_files(const Args& args, const offline::EncodeSettings& settings, const Globals& g, const std::string& list,
+                       const std::string& outdir, const std::vector<std::string>& inputs, const std::set<std::string>& done,
+                       Report& report) {
   const bool skip_existing = args.has("--skip-existing");
-  const std::string report_path = args.get("--report").value_or("");
-
-  const std::vector<std::string> all = distinct(manifest_entries(read_manifest(list)));
-  check_manifest_outputs(all, outdir, report_path);
-  std::vector<std::string> inputs;
-  // (i + count could wrap around with a huge N and take every entry: step only while it fits.)
-  for (uint64_t i = shard.index; i < all.size(); i = all.size() - i > shard.count ? i + shard.count : all.size())
-    inputs.push_back(all[size_t(i)]);
-  if (!report_path.empty()) check_report(report_path, list, inputs), check_output_name(report_path, json_lines_format());
-  const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
-  Report report(report_path);
-
   Globals quiet = g;
   quiet.verbosity = std::min(g.verbosity, 1);
   EncodeTally tally;
@@ -235,6 +175,35 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
   }, inputs);
   if (g.verbosity > 0) std::cerr << tally.line(list == "-" ? "(standard input)" : list, outdir, inputs.size()) << "\n";
   return code;
+}
+
+}  // namespace
+
+int encode_manifest(const Args& args, const offline::EncodeSettings& settings, Globals& g) {
+  if (!args.positional().empty()) fail(kUsage, "encode --manifest takes no input file: the list names them");
+  const bool bank = args.has("--bank");
+  const std::string list = *args.get("--manifest");
+  const std::string out = args.get("-o").value_or(args.get("--output").value_or(""));
+  if (out.empty() || out == "-") fail(kUsage, bank ? "encode --manifest --bank needs -o LIB.kbank" : "encode --manifest needs -o OUTDIR");
+  const Shard shard = parse_shard(args.get("--shard").value_or("0/1"));
+  const std::string report_path = args.get("--report").value_or("");
+
+  const std::vector<std::string> all = distinct(manifest_entries(read_manifest(list)));
+  if (bank) check_manifest_names(all);
+  else check_manifest_outputs(all, out, report_path);
+  std::vector<std::string> inputs;
+  // (i + count could wrap around with a huge N and take every entry: step only while it fits.)
+  for (uint64_t i = shard.index; i < all.size(); i = all.size() - i > shard.count ? i + shard.count : all.size())
+    inputs.push_back(all[size_t(i)]);
+  if (!report_path.empty()) {
+    check_report(report_path, list, inputs), check_output_name(report_path, json_lines_format());
+    if (bank && fs::path(report_path).lexically_normal() == fs::path(out).lexically_normal())
+      fail(kOutputFailed, report_path + ": is the bank (-o) too");
+  }
+  const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
+  Report report(report_path);
+  if (bank) return encode_shard_bank(args, settings, g, inputs, done, report);
+  return encode_shard_files(args, settings, g, list, out, inputs, done, report);
 }
 
 }  // namespace keyanim::cli

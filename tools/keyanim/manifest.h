@@ -14,7 +14,7 @@ namespace keyanim::cli {
 
 // The manifest options, to declare in encode's Args.
 inline const char* const kManifestValuedOptions[] = {"--manifest", "--shard", "--report"};
-inline const char* const kManifestFlags[] = {"--skip-existing"};
+inline const char* const kManifestFlags[] = {"--skip-existing", "--bank"};
 
 // Shard I of N: entries I, I + N, I + 2N, ... of the list (0 <= I < N).
 struct Shard {
