@@ -5,7 +5,10 @@ first, middle and last frames equals `keyanim sample --world` of the file encode
 every frame and a tolerance of 1e-6% (`--keys uniform:1 --error 0.000001%`), within the float
 margin plus that clip's own error against the file as the encoder measured it (its notes'
 max_error: about 1e-8 of the skeleton's size); the scene plays at the file's rate over its
-frames. A malformed file is refused with a report naming it, line and column."""
+frames. The action exported through the add-on passes `keyanim verify --against FILE.bvh
+--max-error 0.06%` (0.05% by the encoder against Blender's pose, which is within the float
+margin of the file): the same skeleton, names and frames. A malformed file is refused with a
+report naming it, line and column."""
 import os
 import sys
 
@@ -35,6 +38,11 @@ def check_file(work, bvh):
     for f in sorted({0, (n - 1) // 2, n - 1}):
         common.compare_pose(obj, 1 + f, common.reference(kanim, f), limit,
                             "%s frame %d" % (name, f))
+    out = os.path.join(work, name + ".blender.kanim")
+    check(bpy.ops.export_anim.keyanim(filepath=out) == {"FINISHED"}, "export %s" % out)
+    v = common.tool_json("verify", out, "--against", bvh, "--max-error", "0.06%")
+    check(v["ok"] and v["valid"], "%s exported: keyanim verify: error max %.3g, allowed %.3g"
+          % (name, v["error"]["max"], v["max_error_allowed"]))
 
 
 def check_malformed(work):

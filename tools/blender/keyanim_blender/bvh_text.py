@@ -10,7 +10,9 @@ def _number(v):
 def _node(skeleton, j, depth, lines):
     pad = "  " * depth
     if skeleton.end_site[j]:
-        lines += [pad + "End Site", pad + "{"]
+        # keyanim names an unnamed End Site "End Site of PARENT"; a named one keeps its name.
+        unnamed = skeleton.names[j] == "End Site of " + skeleton.names[skeleton.parents[j]]
+        lines += [pad + "End Site" + ("" if unnamed else " " + skeleton.names[j]), pad + "{"]
     else:
         lines += [pad + ("ROOT " if skeleton.parents[j] < 0 else "JOINT ") + skeleton.names[j], pad + "{"]
     lines.append(pad + "  OFFSET " + " ".join(_number(v) for v in skeleton.offsets[j]))
@@ -23,10 +25,12 @@ def _node(skeleton, j, depth, lines):
 
 
 def check(skeleton):
-    """Raises ValueError for what BVH text cannot hold, naming the node."""
+    """Raises ValueError for what BVH text cannot hold, naming the node: a name is the rest of
+    its line, so it may hold inner spaces but no line break, no space at either end, no brace."""
     for j, name in enumerate(skeleton.names):
-        if not skeleton.end_site[j] and (not name or any(ch.isspace() or ch in "{}" for ch in name)):
-            raise ValueError("joint %r: a BVH joint name cannot be empty or hold spaces or braces" % name)
+        if not name or name != name.strip() or any(ch in "{}\r\n" for ch in name):
+            raise ValueError("joint %r: a BVH name cannot be empty, start or end with a space, "
+                             "or hold a brace or a line break" % name)
         for kind in skeleton.channels[j]:
             if kind not in ROTATIONS + POSITIONS:
                 raise ValueError("joint %r: unknown channel %r" % (name, kind))

@@ -39,8 +39,10 @@ class ImportBvhKeyanim(bpy.types.Operator, ImportHelper):
         with report.errors(self, self.filepath):
             keyanim = module.load(prefs.module_dir(context))
             motion = keyanim.read_bvh(self.filepath)
-            if motion.frame_count == 0 or not motion.frame_time > 0:
-                raise ValueError("no frames, or a Frame Time of %r: nothing to key" % motion.frame_time)
+            if motion.frame_count == 0:
+                raise ValueError("the file has no frames: nothing to key")
+            if not motion.frame_time > 0:
+                raise ValueError("Frame Time %r: Blender needs a rate above 0" % motion.frame_time)
             skel = skeleton.from_keyanim(motion)
             q = motion.local_quaternions()
             build.build(context, os.path.splitext(os.path.basename(self.filepath))[0], skel, q,
