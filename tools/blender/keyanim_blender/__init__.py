@@ -4,7 +4,7 @@ File > Export > keyanim, through the keyanim Python module (module.py says where
 Convention: an armature's own space is the file's (BVH is usually Y up); the armature object is
 turned +90 degrees about X so that the motion stands up in Blender's Z-up world. A bone per BVH
 node (End Sites are leaf bones), named as the joints; the scene takes the clip's rate and range,
-its first frame at Start Frame (1 by default, Blender's own). tools/blender/README.md has more.
+its first frame at Start Frame (1 by default, Blender's own). README.md, "In Blender", has more.
 """
 bl_info = {
     "name": "keyanim",
