@@ -6,7 +6,6 @@ first, middle and last frames equal `keyanim sample BANK:NAME --world` within th
 the Clip field suggests the bank's names; with no name the first clip comes in; a name the bank
 lacks is refused with a report naming the file and the clips it has."""
 import os
-import subprocess
 import sys
 
 import bpy

@@ -8,7 +8,6 @@ import math
 import bpy
 import numpy as np
 
-from .skeleton import Skeleton
 
 UP = (math.pi / 2, 0.0, 0.0)  # the object's rotation: file Y up -> Blender Z up
 
