@@ -38,11 +38,15 @@ FUZZ_RT=(libclang-rt-14-dev libclang-rt-dev)
 # as commands), chromium runs its browser tests (driven by puppeteer-core, which never downloads
 # a browser). viewer/test/zstd.test.mjs also uses the zstd program, which REQUIRED installs.
 VIEWER=(chromium)
+# The Blender add-on (tools/blender/): Debian's blender, whose Python is the system's 3.11, so it
+# loads the module built for /usr/bin/python3; tests/blender runs it headless. Large (765 MB with
+# the libraries it pulled in on this project's Debian 12), but CI runs those checks.
+BLENDER=(blender)
 
 installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }
 
 missing=()
-for p in "${REQUIRED[@]}" "${FUZZ[@]}" "${VIEWER[@]}"; do installed "$p" || missing+=("$p"); done
+for p in "${REQUIRED[@]}" "${FUZZ[@]}" "${VIEWER[@]}" "${BLENDER[@]}"; do installed "$p" || missing+=("$p"); done
 fuzz_rt=""
 for p in "${FUZZ_RT[@]}"; do installed "$p" && fuzz_rt=$p; done
 if { ! command -v node || ! command -v npm; } >/dev/null 2>&1; then missing+=(nodejs npm); fi

@@ -38,6 +38,11 @@ csharp)  # the C# example's compiler and runtime (tests/capi) are among the test
   [ "$(run)" = 0 ] || die "exit code"
   grep -q '^apt-get .* install .*mono-mcs mono-runtime' "$T/calls.log" || die "mono-mcs and mono-runtime not installed"
   ;;
+blender)  # the Blender add-on's checks (tests/blender) need Debian's blender
+  echo blender >"$T/absent"
+  [ "$(run)" = 0 ] || die "exit code"
+  grep -q '^apt-get .* install .*blender' "$T/calls.log" || die "blender not installed"
+  ;;
 sudo)  # not root, sudo available: apt-get through sudo
   echo help2man >"$T/absent"
   stub id 'echo 1000'
