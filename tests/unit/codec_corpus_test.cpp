@@ -4,12 +4,16 @@
 // both readings of position channels where the file has them below the root, measured on what a
 // decoder makes of the bytes by an independent forward kinematics (shell_reference.h). The same
 // clip through format 4's runtime profile (loaded, viewed, converted back) decodes to the same
-// values bit for bit, and converted back to the archive profile it decodes to them again.
+// values bit for bit, and converted back to the archive profile it decodes to them again. The
+// whole corpus packed into one bank, in either profile, decodes to those values again, clip by
+// clip (so every clip of the bank is within the tolerance checked here).
 #include <doctest/doctest.h>
 
 #include <cstring>
 
 #include "corpus_files.h"
+#include "keyanim/bank.h"
+#include "keyanim/offline/bank.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/decode.h"
@@ -20,6 +24,7 @@
 
 using namespace keyanim;
 using namespace keyanim::offline;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -69,6 +74,37 @@ void check_runtime_profile(const std::vector<uint8_t>& archive, const Clip& clip
   (void)archive;
 }
 
+// FNV-1a of a motion's values' bytes: what a bank's clip must decode to, without keeping every
+// decoded corpus motion in memory.
+uint64_t values_hash(const Motion& m) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  const auto* p = reinterpret_cast<const uint8_t*>(m.values.data());
+  for (size_t i = 0; i < m.values.size() * sizeof(double); ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  return h;
+}
+
+// The corpus's clips in one bank of each profile: each decodes to the values its own file did.
+void check_corpus_bank(const std::vector<BankInput>& clips, const std::vector<uint64_t>& hashes) {
+  for (const bool runtime : {false, true}) {
+    CAPTURE(runtime);
+    BankOptions o;
+    o.runtime = runtime;
+    const WrittenBank w = write_bank(clips, o);
+    Bank bank;
+    REQUIRE(Bank::open(w.bytes, bank) == Status::ok);
+    REQUIRE(bank.clip_count() == clips.size());
+    CHECK(w.skeletons < clips.size());  // the corpus shares skeletons (CMU's, Bandai's)
+    for (uint32_t i = 0; i < bank.clip_count(); ++i) {
+      CAPTURE(clips[i].name);
+      const std::optional<uint32_t> at = bank.find(clips[i].name);
+      REQUIRE(at == i);
+      Clip clip;
+      REQUIRE(bank.clip(i, clip) == Status::ok);
+      CHECK(values_hash(decode_motion(clip)) == hashes[i]);
+    }
+  }
+}
+
 long double reference_error(const Motion& a, const Motion& b, long double shell, uint32_t& readings) {
   long double worst = 0;
   readings = 0;
@@ -91,6 +127,8 @@ TEST_SUITE("corpus") {
       KEYANIM_SKIP_CORPUS_TEST(keyanim::test::corpus_dir().string());
       return;
     }
+    std::vector<BankInput> bank;
+    std::vector<uint64_t> hashes;
     for (const auto& path : files) {
       CAPTURE(path.filename().string());
       const Motion m = read_bvh_file(path.string());
@@ -118,6 +156,10 @@ TEST_SUITE("corpus") {
       CHECK(readings == (e.both_readings ? 2u : 1u));
       CHECK(r.tolerance_units == doctest::Approx(0.0005 * reference_size(m)));
       if (skeleton_size(m.skeleton) > 0.0) CHECK(reference_size(m) == skeleton_size(m.skeleton));
+      fs::path name = path.lexically_relative(keyanim::test::corpus_dir());
+      bank.push_back({name.replace_extension().generic_string(), r.clip});
+      hashes.push_back(values_hash(back));
     }
+    check_corpus_bank(bank, hashes);
   }
 }
