@@ -28,6 +28,8 @@
 #include "keyanim/offline/encode.h"
 #include "keyanim/offline/error.h"
 
+#include "le_bytes.h"
+
 using keyanim::Bank;
 using keyanim::Clip;
 using keyanim::ErrorInfo;
@@ -59,14 +61,8 @@ const std::vector<off::BankInput>& inputs() {
   return in;
 }
 
-uint64_t get_le(const std::vector<uint8_t>& b, uint64_t at, int n) {
-  uint64_t v = 0;
-  for (int i = n - 1; i >= 0; --i) v = (v << 8) | b.at(at + uint64_t(i));
-  return v;
-}
-void put_le(std::vector<uint8_t>& b, uint64_t at, int n, uint64_t v) {
-  for (int i = 0; i < n; ++i) b.at(at + uint64_t(i)) = uint8_t(v >> (8 * i));
-}
+using container_test::get_le;
+using container_test::put_le;
 
 // Section 10.1's offsets, from the header.
 struct Layout {

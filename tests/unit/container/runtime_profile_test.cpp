@@ -28,6 +28,7 @@
 #include "keyanim/offline/container.h"
 
 #include "clips.h"
+#include "le_bytes.h"
 
 using namespace container_test;
 
@@ -50,14 +51,8 @@ struct Aligned {
   std::span<const uint8_t> span() { return {data(), size}; }
 };
 
-uint64_t get_le(const std::vector<uint8_t>& b, uint64_t at, int n) {
-  uint64_t v = 0;
-  for (int i = n - 1; i >= 0; --i) v = (v << 8) | b.at(at + uint64_t(i));
-  return v;
-}
-void put_le(std::vector<uint8_t>& b, uint64_t at, int n, uint64_t v) {
-  for (int i = 0; i < n; ++i) b.at(at + uint64_t(i)) = uint8_t(v >> (8 * i));
-}
+using container_test::get_le;
+using container_test::put_le;
 
 // Section 9.1, rule 3: the last 8 bytes are the XXH64 (seed 0) of all before them.
 void fix_xxh64(std::vector<uint8_t>& b) { put_le(b, b.size() - 8, 8, XXH64(b.data(), b.size() - 8, 0)); }
