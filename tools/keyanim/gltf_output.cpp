@@ -90,6 +90,7 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
     o.tolerance_in_percent = s.tolerance_in_percent;
   }
   o.linear_only = args.has("--linear");
+  o.bone_mesh = !args.has("--no-mesh");
   o.fps = opt.fps;
   o.first_frame = opt.first_frame;
   o.last_frame = opt.last_frame;

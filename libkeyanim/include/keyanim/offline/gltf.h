@@ -53,6 +53,9 @@ struct GltfOptions {
   // rotations, for players that ignore CUBICSPLINE tangents (Blender 3.4's importer keeps the
   // key values and lays its own Bezier handles through them).
   bool linear_only = false;
+  // Defaults to true: the skin comes with a mesh drawing the bones (gltf_skin.h). False: the skin
+  // alone (Debian's Blender 3.4 fails on any glTF mesh with its default Shading, see README).
+  bool bone_mesh = true;
   uint32_t first_frame = 0;          // Defaults to 0: source frames to export (inclusive);
   uint32_t last_frame = UINT32_MAX;  // Defaults to the last frame. Time 0 is first_frame.
   // Defaults to "": a binary .glb. Otherwise a .gltf JSON whose buffer is the file at this URI
