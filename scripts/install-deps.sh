@@ -39,11 +39,15 @@ FUZZ_RT=(libclang-rt-14-dev libclang-rt-dev)
 # a browser); zstd, the command-line tool, makes the reference frames (with a dictionary it
 # trains) that viewer/test/zstd.test.mjs decodes.
 VIEWER=(chromium zstd)
+# Blender, Debian's 3.4 (about 170 packages): the glTF export's import into an armature and action
+# (tests/gltf/blender_check.sh, blender_skin_check.sh: CTest gltf_blender, gltf_blender_corpus)
+# and the Blender add-on's tests run headless in it; without it those tests are skipped (77).
+BLENDER=(blender)
 
 installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }
 
 missing=()
-for p in "${REQUIRED[@]}" "${FUZZ[@]}" "${VIEWER[@]}"; do installed "$p" || missing+=("$p"); done
+for p in "${REQUIRED[@]}" "${FUZZ[@]}" "${VIEWER[@]}" "${BLENDER[@]}"; do installed "$p" || missing+=("$p"); done
 fuzz_rt=""
 for p in "${FUZZ_RT[@]}"; do installed "$p" && fuzz_rt=$p; done
 if { ! command -v node || ! command -v npm; } >/dev/null 2>&1; then missing+=(nodejs npm); fi
