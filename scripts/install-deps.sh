@@ -38,9 +38,10 @@ FUZZ_RT=(libclang-rt-14-dev libclang-rt-dev)
 # as commands), chromium runs its browser tests (driven by puppeteer-core, which never downloads
 # a browser). viewer/test/zstd.test.mjs also uses the zstd program, which REQUIRED installs.
 VIEWER=(chromium)
-# The Blender add-on (tools/blender/): Debian's blender, whose Python is the system's 3.11, so it
-# loads the module built for /usr/bin/python3; tests/blender runs it headless. Large (765 MB with
-# the libraries it pulled in on this project's Debian 12), but CI runs those checks.
+# Debian's blender 3.4, whose Python is the system's 3.11, so it loads the module built for
+# /usr/bin/python3: the add-on's checks (tools/blender/, tests/blender) and the glTF export's
+# import into one armature and action (CTest gltf_blender, gltf_blender_corpus) run headless in
+# it; without it those tests are skipped (77). Large (765 MB with its libraries on Debian 12).
 BLENDER=(blender)
 
 installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }

@@ -94,12 +94,14 @@ def up(q):
 def main():
     gltf, buffer = read_glb(sys.argv[1])
     joints, frame_time, frames = read_chain_bvh(sys.argv[2])
-    nodes = gltf["nodes"]
-    need(len(nodes) == joints + 1, "%d nodes for %d joints and an End Site" % (len(nodes), joints))
+    nodes = gltf["nodes"][:joints + 1]
+    need(len(gltf["nodes"]) == joints + 2, "%d nodes for %d joints, an End Site and the bone mesh" % (len(gltf["nodes"]), joints))
+    need(gltf["nodes"][-1] == {"name": "keyanim bones", "mesh": 0, "skin": 0}, "the last node is not the skinned bone mesh")
+    need(gltf["skins"][0]["joints"] == list(range(joints + 1)), "the skin's joints are not the chain")
     for i, node in enumerate(nodes):
         need(node.get("children", []) == ([i + 1] if i < joints else []), "node %d is not a link of the chain" % i)
         need(node.get("translation") == [0, 1, 0], "node %d is not at its OFFSET" % i)
-    need(gltf["scenes"][gltf.get("scene", 0)]["nodes"] == [0], "the scene is not the chain's root")
+    need(gltf["scenes"][gltf.get("scene", 0)]["nodes"] == [0, joints + 1], "the scene is not the chain's root and the mesh")
     (animation,) = gltf["animations"]
     local = [[(0.0, 0.0, 0.0, 1.0)] * len(frames) for _ in nodes]
     for channel in animation["channels"]:

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Blender as a second, independent glTF player (not part of scripts/test.sh: Debian's blender
-# package is large; CTest runs it only where `blender` is installed):
+# Blender as a second, independent glTF player (CTest gltf_blender; scripts/install-deps.sh
+# installs Debian's blender, and without it this exits 77, skipped):
 #   blender_check.sh KEYANIM FILE.bvh...
 # Encodes each BVH at 0.05%, exports it twice, plays both in Blender's glTF importer
 # (blender_play.py) and compares every node and shell point with forward kinematics of the clip

@@ -218,7 +218,7 @@ Glb export_glb(const Clip& clip, const GltfOptions& o, GltfReport* report = null
 std::vector<std::array<double, 3>> gltf_points(const Glb& g, const std::map<std::pair<int, std::string>, Track>& tr,
                                                double s, bool nlerp, double shell) {
   const json& nodes = g.doc["nodes"];
-  const size_t n = nodes.size();
+  const size_t n = g.doc["skins"][0]["joints"].size();  // the joints' nodes come first, the mesh node after
   std::vector<int> parent(n, -1);
   for (size_t j = 0; j < n; ++j)
     for (const json& c : nodes[j].value("children", json::array())) parent[c.get<size_t>()] = int(j);
@@ -350,28 +350,39 @@ TEST_CASE("glTF asset: nodes, hierarchy, names, one animation, a packed buffer, 
   o.name = "walk";
   const Glb g = export_glb(clip, o);
   const json& nodes = g.doc["nodes"];
-  REQUIRE(nodes.size() == 7);
+  REQUIRE(nodes.size() == 8);  // 7 joints and End Sites, then the bone mesh
   CHECK(nodes[1]["name"] == "Sp\"ine\\ \x01");
   CHECK(nodes[2]["name"] == "Head \xef\xbf\xbd\xef\xbf\xbd:1");
-  CHECK(nodes[3]["name"] == "Head \xef\xbf\xbd\xef\xbf\xbd:1_End");  // End Sites: parent's name + _End
+  CHECK(nodes[3]["name"] == "End Site of Head \xef\xbf\xbd\xef\xbf\xbd:1");  // as keyanim sample --world names it
   CHECK(nodes[4]["name"] == "Bra\xc3\xa7o");
   CHECK(nodes[0]["children"] == json::array({1}));
   CHECK(nodes[1]["children"] == json::array({2, 4}));
   CHECK(nodes[6]["translation"] == json::array({8.0, 0.0, 0.0}));
   CHECK_FALSE(nodes[6].contains("children"));
-  CHECK(g.doc["scenes"][0]["nodes"] == json::array({0}));
+  CHECK(g.doc["scenes"][0]["nodes"] == json::array({0, 7}));
   CHECK(g.doc["asset"]["version"] == "2.0");
   CHECK(g.doc["animations"][0]["name"] == "walk");
-  // One buffer, one view, no byte left over: every accessor's floats laid end to end.
+  // One buffer, its views laid end to end (each 4-byte aligned), every accessor inside its view,
+  // no byte left over but alignment padding.
   CHECK(g.doc["buffers"].size() == 1);
   CHECK(g.doc["buffers"][0]["byteLength"] == g.bin.size());
   CHECK_FALSE(g.doc["buffers"][0].contains("uri"));
+  size_t end = 0;
+  for (const json& v : g.doc["bufferViews"]) {
+    CHECK(v.value("byteOffset", size_t(0)) == (end + 3) / 4 * 4);
+    end = v.value("byteOffset", size_t(0)) + v["byteLength"].get<size_t>();
+  }
+  CHECK((end + 3) / 4 * 4 == g.bin.size());
   size_t bytes = 0;
   for (const json& a : g.doc["accessors"]) {
     const std::string type = a["type"];
-    bytes += 4 * a["count"].get<size_t>() * (type == "SCALAR" ? 1 : type == "VEC3" ? 3 : 4);
+    const size_t width = a["componentType"] == 5126 || a["componentType"] == 5125 ? 4 : a["componentType"] == 5123 ? 2 : 1;
+    const size_t size = width * a["count"].get<size_t>() * (type == "SCALAR" ? 1 : type == "VEC3" ? 3 : type == "VEC4" ? 4 : 16);
+    CHECK(a.value("byteOffset", size_t(0)) + size <= g.doc["bufferViews"][a["bufferView"].get<size_t>()]["byteLength"]);
+    bytes += size;
   }
-  CHECK(bytes == g.bin.size());
+  CHECK(bytes <= g.bin.size());
+  CHECK(bytes + 3 * g.doc["bufferViews"].size() >= g.bin.size());
   // The same asset as .gltf + .bin.
   o.bin_uri = "walk data.bin";
   const GltfOutput split = keyanim::offline::export_gltf(clip, o);
@@ -494,8 +505,110 @@ TEST_CASE("glTF: a clip without frames has nodes and no animation, and one frame
   e.frame_count = 0;
   for (EncodedChannel& c : e.channels) c.frames.clear(), c.q.clear();
   const Glb g = export_glb(keyanim::offline::to_clip(e), {});
-  CHECK(g.doc["nodes"].size() == 7);
+  CHECK(g.doc["nodes"].size() == 8);  // and the skin: an armature without motion
   CHECK_FALSE(g.doc.contains("animations"));
-  CHECK_FALSE(g.doc.contains("buffers"));
-  CHECK(g.bin.empty());
+  CHECK(g.doc["skins"].size() == 1);
+  CHECK(g.doc["scenes"][0]["extras"]["keyanim"]["frame_count"] == 0);
+}
+
+namespace {
+
+// An accessor of any component type, as numbers (normalized integers kept as stored).
+std::vector<double> raw_accessor(const Glb& g, int index) {
+  const json& a = g.doc["accessors"][index];
+  const json& view = g.doc["bufferViews"][a["bufferView"].get<int>()];
+  const std::string type = a["type"];
+  const size_t k = type == "SCALAR" ? 1 : type == "VEC3" ? 3 : type == "VEC4" ? 4 : 16;
+  const int ct = a["componentType"];
+  const size_t width = ct == 5126 || ct == 5125 ? 4 : ct == 5123 ? 2 : 1;
+  const size_t at = view.value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0));
+  const size_t count = a["count"].get<size_t>() * k;
+  REQUIRE(at + width * count <= g.bin.size());
+  std::vector<double> v(count);
+  for (size_t i = 0; i < count; ++i) {
+    uint32_t u = 0;
+    std::memcpy(&u, g.bin.data() + at + width * i, width);  // little-endian host, as the tests run
+    float f;
+    std::memcpy(&f, &u, 4);
+    v[i] = ct == 5126 ? double(f) : double(u);
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("glTF skin: every node a joint, inverse bind matrices of the rest pose, a bone mesh, the timing in extras") {
+  const Clip clip = keyanim::offline::to_clip(test_clip(TangentRule::step_adjusted));
+  GltfOptions o;
+  o.name = "walk";
+  const Glb g = export_glb(clip, o);
+  const auto& joints = clip.skeleton().joints;
+  const json& skin = g.doc["skins"][0];
+  CHECK(skin["name"] == "walk");
+  CHECK(skin["skeleton"] == 0);
+  REQUIRE(skin["joints"].size() == joints.size());
+  for (size_t j = 0; j < joints.size(); ++j) CHECK(skin["joints"][j] == j);
+  // Rest world positions by adding OFFSETs down the hierarchy: the inverse bind matrix of each
+  // node is the translation by minus that, column-major.
+  std::vector<std::array<double, 3>> rest(joints.size());
+  for (size_t j = 0; j < joints.size(); ++j)
+    for (int a = 0; a < 3; ++a) rest[j][a] = (joints[j].parent < 0 ? 0.0 : rest[size_t(joints[j].parent)][a]) + joints[j].offset[a];
+  const std::vector<double> ibm = raw_accessor(g, skin["inverseBindMatrices"]);
+  REQUIRE(ibm.size() == 16 * joints.size());
+  for (size_t j = 0; j < joints.size(); ++j)
+    for (int c = 0; c < 16; ++c) {
+      const double want = c >= 12 && c < 15 ? -rest[j][c - 12] : c % 5 == 0 ? 1.0 : 0.0;
+      CHECK(ibm[16 * j + size_t(c)] == double(float(want)));
+    }
+  // The mesh node: a scene root without a transform, after the joints.
+  const json& node = g.doc["nodes"][joints.size()];
+  CHECK(node["mesh"] == 0);
+  CHECK(node["skin"] == 0);
+  CHECK_FALSE(node.contains("translation"));
+  CHECK_FALSE(node.contains("children"));
+  // Every vertex follows one joint with weight 1; each bone of 5 vertices runs from its parent's
+  // rest position (head, ring: the parent) to its node's (tail: the node itself).
+  const json& prim = g.doc["meshes"][0]["primitives"][0];
+  const std::vector<double> pos = raw_accessor(g, prim["attributes"]["POSITION"]);
+  const std::vector<double> jw = raw_accessor(g, prim["attributes"]["JOINTS_0"]);
+  const std::vector<double> ww = raw_accessor(g, prim["attributes"]["WEIGHTS_0"]);
+  const std::vector<double> idx = raw_accessor(g, prim["indices"]);
+  CHECK(g.doc["accessors"][prim["attributes"]["WEIGHTS_0"].get<int>()]["normalized"] == true);
+  size_t segments = 0;
+  for (size_t j = 1; j < joints.size(); ++j) segments += joints[j].offset != std::array<double, 3>{0, 0, 0};
+  REQUIRE(pos.size() == 15 * segments);
+  REQUIRE(idx.size() == 18 * segments);
+  for (size_t v = 0; v < pos.size() / 3; ++v) {
+    CHECK(ww[4 * v] == 255);
+    CHECK(ww[4 * v + 1] + ww[4 * v + 2] + ww[4 * v + 3] == 0);
+  }
+  size_t bone = 0;
+  for (size_t n = 1; n < joints.size(); ++n) {
+    if (joints[n].offset == std::array<double, 3>{0, 0, 0}) continue;
+    const size_t p = size_t(joints[n].parent), head = 5 * bone, tail = head + 1;
+    CHECK(jw[4 * head] == p);
+    CHECK(jw[4 * tail] == n);
+    for (size_t r = head + 2; r < head + 5; ++r) CHECK(jw[4 * r] == p);
+    for (int a = 0; a < 3; ++a) {
+      CHECK(pos[3 * head + size_t(a)] == double(float(rest[p][a])));
+      CHECK(pos[3 * tail + size_t(a)] == double(float(rest[n][a])));
+    }
+    ++bone;
+  }
+  for (double i : idx) CHECK(i < double(pos.size() / 3));
+  // The frame rate and range in the scene's, the animation's and the asset's extras.
+  for (const json* extras : {&g.doc["scenes"][0]["extras"], &g.doc["animations"][0]["extras"], &g.doc["asset"]["extras"]}) {
+    const json& k = (*extras)["keyanim"];
+    CHECK(k["fps"].get<double>() == doctest::Approx(30.0).epsilon(1e-12));
+    CHECK(k["first_frame"] == 0);
+    CHECK(k["last_frame"] == 60);
+    CHECK(k["frame_count"] == 61);
+  }
+  // Without the mesh: the skin alone, no mesh node.
+  o.bone_mesh = false;
+  const Glb bare = export_glb(clip, o);
+  CHECK(bare.doc["nodes"].size() == joints.size());
+  CHECK_FALSE(bare.doc.contains("meshes"));
+  CHECK(bare.doc["skins"][0]["joints"].size() == joints.size());
+  CHECK(bare.doc["scenes"][0]["nodes"] == json::array({0}));
 }

@@ -16,7 +16,7 @@ namespace keyanim::cli {
 
 const char* const kDecodeHelp =
     "usage: keyanim decode IN.kanim [-o OUT.bvh|OUT.glb|OUT.gltf] [--to bvh|gltf] [--fps F | --inbetweens N]\n"
-    "                      [--frames A:B] [--error E|E%] [--linear] [-f]\n"
+    "                      [--frames A:B] [--error E|E%] [--linear] [--no-mesh] [-f]\n"
     "Rebuilds every frame from the keyframes by Cardinal interpolation.\n"
     "  -o, --output FILE     output (default: IN with .bvh, or .glb with --to gltf; '-' = standard output)\n"
     "  --fps F               resample at F frames per second (F > 0; default: the source rate).\n"
@@ -31,7 +31,8 @@ const char* const kDecodeHelp =
     "The BVH is written as it is decoded (memory does not grow with its length); a request for\n"
     "more than --max-values values (frames x channels) is refused before any is made (exit 6).\n"
     "glTF 2.0 output (.gltf writes its buffer to OUT.bin beside it; '-' gets a .glb): one node per\n"
-    "joint and End Site, one animation. Translations are the clip's curves exactly (CUBICSPLINE);\n"
+    "joint and End Site, all joints of one skin (an armature in Blender) with a mesh drawing the\n"
+    "bones, one animation. Translations are the clip's curves exactly (CUBICSPLINE);\n"
     "rotations are quaternion keys fitted so that every joint, End Site and shell point (2% of\n"
     "the skeleton size along each joint's axes) stays within --error of the clip at every source\n"
     "frame, as a glTF player computes it. With --fps, LINEAR keys every 1/F s instead (the error\n"
@@ -39,16 +40,19 @@ const char* const kDecodeHelp =
     "  --error E|E%          the fit's world-space tolerance, length units or percent of the skeleton\n"
     "                        size (default: the tolerance the clip was encoded with, else 0.05%)\n"
     "  --linear              LINEAR keys only, translations fitted too: for players that ignore\n"
-    "                        CUBICSPLINE tangents (Blender's glTF importer)\n";
+    "                        CUBICSPLINE tangents (Blender's glTF importer)\n"
+    "  --no-mesh             the skin without the mesh that draws the bones (Debian's Blender 3.4\n"
+    "                        fails to import any glTF mesh unless Shading is Flat)\n";
 
 int cmd_decode(const Argv& argv, Globals& g) {
-  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames", "--to", "--error"}, {"--linear"});
+  const Args args(argv, {"-o", "--output", "--fps", "--inbetweens", "--frames", "--to", "--error"}, {"--linear", "--no-mesh"});
   if (args.positional().size() != 1) fail(kUsage, "decode takes one input file");
   const std::string in = args.positional()[0];
   std::string out = args.get("-o").value_or("");
   const bool gltf = wants_gltf(args, out);
   if (out.empty()) out = in == "-" ? "-" : swap_extension(in, gltf ? ".glb" : ".bvh");
-  if ((args.has("--error") || args.has("--linear")) && !gltf) fail(kUsage, "--error and --linear apply to glTF output");
+  if ((args.has("--error") || args.has("--linear") || args.has("--no-mesh")) && !gltf)
+    fail(kUsage, "--error, --linear and --no-mesh apply to glTF output");
 
   offline::ResampleOptions opt;
   if (args.has("--fps") && args.has("--inbetweens")) fail(kUsage, "--fps and --inbetweens exclude each other");

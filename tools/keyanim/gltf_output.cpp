@@ -90,6 +90,7 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
     o.tolerance_in_percent = s.tolerance_in_percent;
   }
   o.linear_only = args.has("--linear");
+  o.bone_mesh = !args.has("--no-mesh");
   o.fps = opt.fps;
   o.first_frame = opt.first_frame;
   o.last_frame = opt.last_frame;
@@ -114,7 +115,7 @@ int decode_gltf(Input& input, const std::string& out, const offline::ResampleOpt
   const offline::GltfOutput asset = or_fail(kUsage, in + ": glTF export: ", [&] { return offline::export_gltf(clip, o); });
   bar.erase();
   const offline::GltfReport& r = asset.report;
-  if (bin && !asset.bin.empty()) {  // a clip without frames has no buffer: no .bin is left
+  if (bin && !asset.bin.empty()) {  // an asset without a buffer leaves no .bin
     bin->write(asset.bin);
     bin->commit();
   }

@@ -2,6 +2,16 @@
 // glTF player (three.js, Babylon.js, Godot, Unity glTFast, Unreal, Blender) plays as keyanim
 // decodes the clip.
 //
+// The skeleton as tools recognise one: every node is a joint of one skin (End Sites are leaf
+// bones, named "End Site of PARENT" when unnamed, as keyanim names them everywhere), with
+// inverse bind matrices of the rest pose, so that Blender builds one armature and three.js
+// THREE.Bones. glTF binds a skin through a mesh node, so by default the skin comes with the
+// smallest mesh that draws the bones (gltf_skin.h: a triangular bipyramid per segment, 5
+// vertices and 6 triangles, about 120 bytes a bone); bone_mesh = false leaves it out. The source
+// frame rate and the exported frame range are in the scene's, the animation's and the asset's
+// extras ("keyanim": fps, source_frame_time, frame_count, first_frame, last_frame): glTF keeps
+// only seconds, and Blender 3.4's importer places keys by the scene's rate (README).
+//
 // What is exact and what is fitted:
 //  - Translations (position channels, and OFFSET components without one) become CUBICSPLINE
 //    (LINEAR where every axis is linear or constant) whose keys are the union of the axes' key
@@ -19,7 +29,8 @@
 //  - Times are seconds in float32, as glTF stores them; the checks evaluate at the player's
 //    times, rounding included, in binary64 as three.js does, and keep a margin of 1e-6 of the
 //    skeleton size for players that round differently (float32 arithmetic, normalising).
-// Nodes carry the rest pose: translation = OFFSET, no rotation. Lengths stay in the file's
+// Nodes carry the rest pose: translation = OFFSET, no rotation; the bone mesh's node is a scene
+// root without a transform, after the joints' nodes. Lengths stay in the file's
 // units (glTF assumes metres: a viewer may need to scale a clip captured in centimetres).
 #pragma once
 #include <cstdint>
@@ -53,6 +64,9 @@ struct GltfOptions {
   // rotations, for players that ignore CUBICSPLINE tangents (Blender 3.4's importer keeps the
   // key values and lays its own Bezier handles through them).
   bool linear_only = false;
+  // Defaults to true: the skin comes with a mesh drawing the bones (gltf_skin.h). False: the skin
+  // alone (Debian's Blender 3.4 fails on any glTF mesh with its default Shading, see README).
+  bool bone_mesh = true;
   uint32_t first_frame = 0;          // Defaults to 0: source frames to export (inclusive);
   uint32_t last_frame = UINT32_MAX;  // Defaults to the last frame. Time 0 is first_frame.
   // Defaults to "": a binary .glb. Otherwise a .gltf JSON whose buffer is the file at this URI

@@ -7,6 +7,7 @@
 
 #include "gltf_curves.h"
 #include "gltf_fit.h"
+#include "gltf_skin.h"
 #include "gltf_verify.h"
 #include "gltf_writer.h"
 #include "keyanim/offline/decode.h"
@@ -113,12 +114,23 @@ double reference_size(const Clip& clip) {
   return offline::reference_size(decode_motion(clip));
 }
 
-std::string extras(const GltfReport& r, const Window& w, double fps) {
+// The source's frame rate and the exported range, as "key":value pairs: glTF keeps only seconds,
+// and importers that count frames (Blender) need the rate to land keys on the source frames.
+std::string timing_members(const Clip& clip, const Window& w) {
+  const uint32_t frames = clip.frame_count() == 0 ? 0 : w.frames();
+  std::string o = "\"source_frame_time\":" + json_number(clip.frame_time());
+  if (clip.frame_time() > 0.0) o += ",\"fps\":" + json_number(1.0 / clip.frame_time());
+  o += ",\"frame_count\":" + std::to_string(frames);
+  if (frames > 0) o += ",\"first_frame\":" + std::to_string(w.first) + ",\"last_frame\":" + std::to_string(w.last);
+  return o;
+}
+
+// asset.extras: what the fit reached and the timing; `resample_fps` the --fps option (0: none).
+std::string extras(const GltfReport& r, const std::string& timing, double resample_fps) {
   std::string o = "{\"keyanim\":{\"tolerance\":" + json_number(r.tolerance) +
                   ",\"shell_distance\":" + json_number(r.shell_distance) + ",\"max_error\":" + json_number(r.max_error) +
-                  ",\"first_frame\":" + std::to_string(w.first) + ",\"last_frame\":" + std::to_string(w.last) +
-                  ",\"source_frame_time\":" + json_number(w.frame_time);
-  if (fps > 0.0) o += ",\"fps\":" + json_number(fps);
+                  "," + timing;
+  if (resample_fps > 0.0) o += ",\"resample_fps\":" + json_number(resample_fps);
   return o + "}}";
 }
 
@@ -217,7 +229,11 @@ GltfOutput export_gltf(const Clip& clip, const GltfOptions& options) {
   }
   if (clip.frame_count() > 0) animate(clip, options, w, size, model, report);
   count_tracks(model, report);
-  model.extras_json = extras(report, w, options.fps);
+  const std::string timing = timing_members(clip, w);
+  model.extras_json = extras(report, timing, options.fps);
+  model.timing_json = "{\"keyanim\":{" + timing + "}}";
+  model.skin = make_skin(model.skeleton);
+  if (!options.bone_mesh) model.skin.positions.clear(), model.skin.joints.clear(), model.skin.indices.clear();
   if (options.bin_uri.empty()) out.main = write_glb(model);
   else write_gltf(model, options.bin_uri, out.main, out.bin);
   if (out.main.size() + out.bin.size() >= (uint64_t(1) << 32))  // GLB and glTF lengths are u32

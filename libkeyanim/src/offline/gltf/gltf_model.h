@@ -4,7 +4,9 @@
 //   gltf_verify.cpp  the clip's forward kinematics against the player's, per point and frame
 //   gltf_fit.cpp     keys fitted within the world-space tolerance (rotations; translations for
 //                    LINEAR-only output)
-//   gltf_writer.cpp  the JSON, the packed buffer and the GLB container
+//   gltf_skin.cpp    the skin: inverse bind matrices, the mesh drawn as the bones
+//   gltf_buffer.cpp  the packed buffer, its views and accessors
+//   gltf_writer.cpp  the JSON and the GLB container
 //   gltf_export.cpp  export_gltf: options, the frame window, putting it together
 #pragma once
 #include <array>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "keyanim/clip.h"
+#include "gltf_skin.h"
 #include "keyanim/offline/fk.h"
 
 namespace keyanim::offline::gltf {
@@ -50,7 +53,9 @@ struct Model {
   Skeleton skeleton;                 // nodes: joints and End Sites, parents first
   std::vector<NodeAnimation> nodes;  // per node; empty optionals keep the rest pose
   std::string animation_name;
+  Skin skin;                         // empty: no skin, no mesh
   std::string extras_json;           // asset.extras, a JSON object (may be empty)
+  std::string timing_json;           // the scene's and the animation's extras (may be empty)
 };
 
 // A quaternion in glTF's order: x, y, z, w.

@@ -3,8 +3,9 @@
 
 #include <charconv>
 #include <cstring>
-#include <map>
 
+#include "gltf_buffer.h"
+#include "keyanim/offline/metrics.h"
 #include "keyanim/version.h"
 
 namespace keyanim::offline::gltf {
@@ -66,56 +67,19 @@ std::string json_string(const std::string& text) {
 
 namespace {
 
-// Accessors over one packed buffer; identical arrays (e.g. the time keys of several tracks)
-// are stored once.
-class BufferBuilder {
- public:
-  // Index of an accessor of `type` ("SCALAR", "VEC3", "VEC4") over `data`.
-  size_t accessor(const std::vector<float>& data, int components, const char* type) {
-    const std::string bytes(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
-    const std::string key = std::string(type) + '\0' + bytes;
-    if (auto it = seen_.find(key); it != seen_.end()) return it->second;
-    std::string a = "{\"bufferView\":0,\"byteOffset\":" + std::to_string(bin_.size()) +
-                    ",\"componentType\":5126,\"count\":" + std::to_string(data.size() / size_t(components)) +
-                    ",\"type\":\"" + type + "\"";
-    std::string mins, maxs;
-    for (int c = 0; c < components; ++c) {
-      float lo = data[size_t(c)], hi = lo;
-      for (size_t i = size_t(c); i < data.size(); i += size_t(components)) lo = std::min(lo, data[i]), hi = std::max(hi, data[i]);
-      mins += (c ? "," : "") + json_number(lo);
-      maxs += (c ? "," : "") + json_number(hi);
-    }
-    a += ",\"min\":[" + mins + "],\"max\":[" + maxs + "]}";
-    bin_ += bytes;  // little-endian float32, 4-byte aligned since everything is float32
-    accessors_.push_back(std::move(a));
-    return seen_[key] = accessors_.size() - 1;
-  }
-  const std::string& bin() const { return bin_; }
-  std::string accessors_json() const {
-    std::string o;
-    for (size_t i = 0; i < accessors_.size(); ++i) o += (i ? "," : "") + accessors_[i];
-    return o;
-  }
-
- private:
-  std::string bin_;
-  std::vector<std::string> accessors_;
-  std::map<std::string, size_t> seen_;
-};
-
 std::string vec_json(const double* v, int n) {
   std::string o = "[";
   for (int i = 0; i < n; ++i) o += (i ? "," : "") + json_number(v[i]);
   return o + "]";
 }
 
-std::string node_name(const Skeleton& sk, size_t j) {
-  const Joint& joint = sk.joints[j];
-  if (!joint.end_site || !joint.name.empty() || joint.parent < 0) return joint.name;
-  return sk.joints[size_t(joint.parent)].name + "_End";
-}
+// Nodes are named as keyanim names points elsewhere (metrics.h, `keyanim sample --world`): an
+// End Site without a name is "End Site of PARENT", so a bone is found by the same name everywhere.
+std::string node_name(const Skeleton& sk, size_t j) { return point_name(sk, uint32_t(j), 0); }
 
-std::string nodes_json(const Skeleton& sk, std::string& roots) {
+// The joints' nodes, parents first (`roots`: those without a parent), then (with a mesh) the mesh
+// node: a root without a transform, as glTF wants of a skinned mesh (the joints alone place it).
+std::string nodes_json(const Skeleton& sk, bool meshed, std::string& roots) {
   std::vector<std::vector<size_t>> children(sk.joints.size());
   for (size_t j = 0; j < sk.joints.size(); ++j) {
     const int32_t p = sk.joints[j].parent;
@@ -134,12 +98,51 @@ std::string nodes_json(const Skeleton& sk, std::string& roots) {
     }
     o += "}";
   }
+  if (meshed) o += (o.empty() ? "{" : ",{") + std::string("\"name\":\"keyanim bones\",\"mesh\":0,\"skin\":0}");
   return o;
 }
 
-// The whole JSON document; `bin_uri` empty for a GLB.
-std::string document(const Model& model, const std::string& bin_uri, std::string& bin) {
-  BufferBuilder buffer;
+// The smallest unsigned glTF component holding `largest`; indices must stay below the
+// primitive-restart value (the type's largest), which glTF forbids in indices.
+Component component_for(uint64_t largest, bool index) {
+  if (largest < (index ? 0xFFu : 0x100u)) return Component::u8;
+  if (largest < (index ? 0xFFFFu : 0x10000u)) return Component::u16;
+  return Component::u32;
+}
+
+// "meshes" and "materials" of the bone mesh: one primitive weighted fully to one joint per
+// vertex (JOINTS_0 = that joint, WEIGHTS_0 = 1, 0, 0, 0) and a plain matte material.
+std::string mesh_json(const Model& model, BufferBuilder& buffer) {
+  const Skin& skin = model.skin;
+  const size_t nodes = model.skeleton.joints.size();
+  const size_t vertices = skin.joints.size();
+  std::vector<uint32_t> joints(4 * vertices, 0), weights(4 * vertices, 0);
+  for (size_t v = 0; v < vertices; ++v) joints[4 * v] = skin.joints[v], weights[4 * v] = 255;
+  const size_t position = buffer.floats(Use::vertices, skin.positions, "VEC3");
+  const size_t joint = buffer.integers(Use::vertices, joints, "VEC4", component_for(nodes - 1, false));
+  const size_t weight = buffer.integers(Use::vertices, weights, "VEC4", Component::u8, true);
+  const size_t index = buffer.integers(Use::indices, skin.indices, "SCALAR", component_for(vertices - 1, true));
+  std::string o = ",\"meshes\":[{\"name\":\"keyanim bones\",\"primitives\":[{\"attributes\":{\"POSITION\":" +
+                  std::to_string(position) + ",\"JOINTS_0\":" + std::to_string(joint) + ",\"WEIGHTS_0\":" +
+                  std::to_string(weight) + "},\"indices\":" + std::to_string(index) + ",\"material\":0}]}]";
+  o += ",\"materials\":[{\"name\":\"keyanim bones\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.8,0.8,0.8,1],"
+       "\"metallicFactor\":0,\"roughnessFactor\":0.8}}]";
+  return o;
+}
+
+// "skins": every node a joint, the skeleton root named when there is one root.
+std::string skin_json(const Model& model, const std::string& roots, BufferBuilder& buffer) {
+  const size_t nodes = model.skeleton.joints.size();
+  const size_t binds = buffer.floats(Use::matrices, model.skin.inverse_binds, "MAT4");
+  std::string o = ",\"skins\":[{\"name\":" + json_string(model.animation_name) + ",\"inverseBindMatrices\":" + std::to_string(binds);
+  if (roots.find(',') == std::string::npos) o += ",\"skeleton\":" + roots;  // one root
+  o += ",\"joints\":[";
+  for (size_t j = 0; j < nodes; ++j) o += (j ? "," : "") + std::to_string(j);
+  return o + "]}]";
+}
+
+// The "animations" member (empty when nothing is animated: a clip without frames).
+std::string animation_json(const Model& model, BufferBuilder& buffer) {
   std::string channels, samplers;
   size_t count = 0;
   for (size_t j = 0; j < model.nodes.size(); ++j) {
@@ -148,8 +151,8 @@ std::string document(const Model& model, const std::string& bin_uri, std::string
     for (const auto& [path, track] : tracks) {
       if (!*track) continue;
       const Sampler& s = **track;
-      const size_t input = buffer.accessor(s.times, 1, "SCALAR");
-      const size_t output = buffer.accessor(s.values, s.components, s.components == 4 ? "VEC4" : "VEC3");
+      const size_t input = buffer.floats(Use::animation, s.times, "SCALAR");
+      const size_t output = buffer.floats(Use::animation, s.values, s.components == 4 ? "VEC4" : "VEC3");
       channels += (count ? "," : "") + std::string("{\"sampler\":") + std::to_string(count) +
                   ",\"target\":{\"node\":" + std::to_string(j) + ",\"path\":\"" + path + "\"}}";
       samplers += (count ? "," : "") + std::string("{\"input\":") + std::to_string(input) +
@@ -158,19 +161,35 @@ std::string document(const Model& model, const std::string& bin_uri, std::string
       ++count;
     }
   }
+  if (count == 0) return "";
+  std::string o = ",\"animations\":[{\"name\":" + json_string(model.animation_name) + ",\"channels\":[" + channels +
+                  "],\"samplers\":[" + samplers + "]";
+  if (!model.timing_json.empty()) o += ",\"extras\":" + model.timing_json;
+  return o + "}]";
+}
+
+// The whole JSON document; `bin_uri` empty for a GLB.
+std::string document(const Model& model, const std::string& bin_uri, std::string& bin) {
+  BufferBuilder buffer;
+  const std::string animations = animation_json(model, buffer);
   std::string roots;
-  const std::string nodes = nodes_json(model.skeleton, roots);
+  const bool meshed = model.skin.has_mesh();
+  const std::string nodes = nodes_json(model.skeleton, meshed, roots);
   std::string o = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"keyanim " KEYANIM_VERSION_STRING "\"";
   if (!model.extras_json.empty()) o += ",\"extras\":" + model.extras_json;
-  o += "},\"scene\":0,\"scenes\":[{\"nodes\":[" + roots + "]}],\"nodes\":[" + nodes + "]";
-  if (count > 0) {
-    o += ",\"animations\":[{\"name\":" + json_string(model.animation_name) + ",\"channels\":[" + channels +
-         "],\"samplers\":[" + samplers + "]}]";
-    const std::string size = std::to_string(buffer.bin().size());
-    o += ",\"accessors\":[" + buffer.accessors_json() + "],\"bufferViews\":[{\"buffer\":0,\"byteLength\":" + size +
-         "}],\"buffers\":[{\"byteLength\":" + size + (bin_uri.empty() ? "" : ",\"uri\":" + json_string(bin_uri)) + "}]";
-  }
+  const std::string scene_roots = roots + (meshed ? "," + std::to_string(model.skeleton.joints.size()) : "");
+  o += "},\"scene\":0,\"scenes\":[{\"nodes\":[" + scene_roots + "]";
+  if (!model.timing_json.empty()) o += ",\"extras\":" + model.timing_json;  // Blender keeps these as scene properties
+  o += "}],\"nodes\":[" + nodes + "]";
+  if (meshed) o += mesh_json(model, buffer);
+  if (!model.skin.empty()) o += skin_json(model, roots, buffer);
+  o += animations;
   bin = buffer.bin();
+  if (!bin.empty()) {
+    const std::string size = std::to_string(bin.size());
+    o += ",\"accessors\":[" + buffer.accessors_json() + "],\"bufferViews\":[" + buffer.views_json() +
+         "],\"buffers\":[{\"byteLength\":" + size + (bin_uri.empty() ? "" : ",\"uri\":" + json_string(bin_uri)) + "}]";
+  }
   return o + "}";
 }
 
