@@ -139,5 +139,24 @@ manifest)
   expect_rc 2 "$K" encode --manifest twice.txt -o t.kbank --bank --shard 1/2
   grep -q "would be named 'lib/hop'" .stderr && [ ! -e t.kbank ] || die "two entries of one name: $(cat .stderr)"
   ;;
+corpus)
+  # The whole corpus (KEYANIM_CORPUS, from CMake) packed by the CLI: every clip listed, and
+  # every clip, read as LIB:NAME, within the default tolerance of its BVH by keyanim verify's
+  # forward kinematics (0.05% of the skeleton size), in both profiles; unpack writes them all.
+  C=${KEYANIM_CORPUS:-}
+  [ -d "$C" ] || { echo "keyanim-corpus-skip: corpus not found"; exit 77; }
+  expect_rc 0 "$K" pack "$C" -o corpus.kbank
+  "$K" list corpus.kbank --json >l.json || die "list --json"
+  n=$(find "$C" -iname '*.bvh' | wc -l)
+  [ "$(json 'len(d["clips"])' <l.json)" = "$n" ] || die "the bank holds $(json 'len(d["clips"])' <l.json) clips, the corpus $n"
+  expect_rc 0 "$K" pack corpus.kbank -o runtime.kbank --runtime
+  for name in $(json '"\n".join(c["name"] for c in d["clips"])' <l.json); do
+    for lib in corpus.kbank runtime.kbank; do
+      expect_rc 0 "$K" verify "$lib:$name" --against "$C/$name.bvh" --max-error 0.05%
+    done
+  done
+  expect_rc 0 "$K" unpack corpus.kbank -o out
+  [ "$(find out -name '*.kanim' | wc -l)" = "$n" ] || die "unpack wrote $(find out -name '*.kanim' | wc -l) files"
+  ;;
 *) die "unknown case $CASE" ;;
 esac
