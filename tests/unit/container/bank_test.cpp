@@ -257,6 +257,26 @@ TEST_CASE("the rules of section 10, broken one at a time") {
       CHECK(open_fails(b) != Status::ok);
     }
   }
+  SUBCASE("every bit flip of a member fails that clip, by its name, and only that clip") {
+    Bank bank;
+    Clip clip;
+    ErrorInfo err;
+    for (uint32_t c = 0; c < l.clips; ++c) {
+      const uint64_t from = get_le(good, l.clip(c), 8), size = get_le(good, l.clip(c) + 8, 8);
+      const std::string name(reinterpret_cast<const char*>(&good[l.names + get_le(good, l.clip(c) + 32, 4)]),
+                             get_le(good, l.clip(c) + 36, 4));
+      for (uint64_t i = from; i < from + size; ++i) {
+        std::vector<uint8_t> b = good;
+        b[i] ^= uint8_t(1u << (i % 8));
+        CAPTURE(i);
+        REQUIRE(Bank::open(b, bank) == Status::ok);  // the index is intact
+        CHECK(bank.clip(c, clip, &err) != Status::ok);
+        CHECK(err.section.find("clip " + name + " (") != std::string::npos);
+        for (uint32_t k = 0; k < l.clips; ++k)
+          if (k != c) CHECK(bank.clip(k, clip) == Status::ok);
+      }
+    }
+  }
   SUBCASE("header") {
     CHECK(broken([](auto& b) { put_le(b, 8, 2, 5); }) == Status::unsupported_version);
     CHECK(broken([](auto& b) { b[12] |= 0x08; }) == Status::reserved_bits_set);
