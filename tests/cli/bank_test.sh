@@ -130,6 +130,11 @@ manifest)
   before=$(stat -c %i s0.kbank)
   expect_rc 2 "$K" encode --manifest list.txt -o s0.kbank --bank --shard 0/2 --skip-existing
   [ "$(stat -c %i s0.kbank)" != "$before" ] || die "--skip-existing kept a bank short of a clip"
+  # A report that is a link to the bank is refused before any work, and the bank is kept.
+  ln -s s1.kbank link.jsonl && cp s1.kbank s1.copy
+  expect_rc 4 "$K" -f encode --manifest list.txt -o s1.kbank --bank --shard 1/2 --report link.jsonl
+  grep -q 'link.jsonl: is the bank (-o) too' .stderr || die "a report linked to the bank: $(cat .stderr)"
+  cmp -s s1.kbank s1.copy || die "a report linked to the bank changed it"
   expect_rc 1 "$K" encode --manifest list.txt -o s0.kanim --bank  # a bank's name says .kbank
   expect_rc 1 "$K" encode lib/hop.bvh --bank
   grep -q -- '--bank goes with --manifest' .stderr || die "--bank without --manifest: $(cat .stderr)"

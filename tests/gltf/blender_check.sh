@@ -8,14 +8,8 @@
 #   --linear exports must stay within the tolerance (exit 1 otherwise);
 #   default exports are reported only: Blender's importer ignores CUBICSPLINE tangents
 #   (glTF-Blender-IO issue 419), so it does not play them as the glTF specification says.
-set -uo pipefail
-HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$(dirname "${BASH_SOURCE[0]}")/blender_common.sh"; shift
 NODE_DIR=${KEYANIM_GLTF_NODE_DIR:-$HERE}  # blender_compare.mjs beside its node_modules (gltf_test.sh)
-K=$(realpath "$1"); shift
-command -v blender >/dev/null || { echo "blender not found: Blender check skipped"; exit 77; }
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-status=0
 for bvh in "$@"; do
   base="$T/$(basename "$bvh" .bvh)"
   "$K" -q encode "$bvh" -o "$base.kanim" --error 0.05% &&

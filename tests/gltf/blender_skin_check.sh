@@ -13,14 +13,8 @@
 # export's) within the clip's tolerance (`keyanim info --json`) plus a float32 margin of 1e-5 of
 # the skeleton size (Blender's pose matrices are float32). Exits 77 (skipped) without blender or
 # without the files.
-set -uo pipefail
-HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-K=$(realpath "$1"); shift
-command -v blender >/dev/null || { echo "blender not found: Blender check skipped"; exit 77; }
+source "$(dirname "${BASH_SOURCE[0]}")/blender_common.sh"; shift
 for bvh in "$@"; do [ -f "$bvh" ] || { echo "$bvh not found (corpus absent?): skipped"; exit 77; }; done
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-status=0
 for bvh in "$@"; do
   base="$T/$(basename "$bvh" .bvh)"
   "$K" -q encode "$bvh" -o "$base.kanim" --error 0.05% &&

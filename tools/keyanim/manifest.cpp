@@ -12,6 +12,7 @@
 #include <iostream>
 #include <iterator>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -197,8 +198,9 @@ int encode_manifest(const Args& args, const offline::EncodeSettings& settings, G
     inputs.push_back(all[size_t(i)]);
   if (!report_path.empty()) {
     check_report(report_path, list, inputs), check_output_name(report_path, json_lines_format());
-    if (bank && fs::path(report_path).lexically_normal() == fs::path(out).lexically_normal())
-      fail(kOutputFailed, report_path + ": is the bank (-o) too");
+    // Their names differ (.jsonl, .kbank), but a link can make them one file.
+    const std::optional<FileId> report_id = input_id(report_path);
+    if (bank && report_id && report_id == input_id(out)) fail(kOutputFailed, report_path + ": is the bank (-o) too");
   }
   const std::set<std::string> done = report_path.empty() ? std::set<std::string>{} : reported_done(report_path);
   Report report(report_path);

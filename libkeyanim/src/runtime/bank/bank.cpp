@@ -140,8 +140,7 @@ std::optional<uint32_t> Bank::find(std::string_view name) const noexcept {
 namespace {
 // The index's Frame_Count and Frame_Time must be the member's CLIP (section 10.3), field by field, so
 // that a reader listing the bank and a reader decoding a clip agree; each mismatch names its field.
-Status check_entry_timing(const internal::BankIndex& idx, uint32_t i, Clip& out, ErrorInfo* err) {
-  const BankEntry e = idx.entry(i);
+Status check_entry_timing(const internal::BankIndex& idx, uint32_t i, const BankEntry& e, Clip& out, ErrorInfo* err) {
   const uint64_t entry = uint64_t(idx.clip_at(i) - idx.bytes.data());
   const double frame_time = out.frame_time();
   uint64_t at = 0;
@@ -182,7 +181,7 @@ Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& lim
   if (s == Status::ok)
     s = internal::load_member(idx.bytes.subspan(e.offset, e.size), m, state_->storage ? state_ : nullptr, limits,
                                    &state_->rigs, out, err);
-  if (s == Status::ok) s = check_entry_timing(idx, i, out, err);
+  if (s == Status::ok) s = check_entry_timing(idx, i, e, out, err);
   if (s != Status::ok && err != nullptr) err->section = "clip " + std::string(e.name) + " (" + std::to_string(i) + "), " + err->section;
   return s;
 }
