@@ -14,6 +14,9 @@
 //     t (and the step the encoder derives from a budget t). q' is rebuilt from the 4 curves and
 //     normalized. t is bisected per joint so that the quaternion fit's worst angle is as large
 //     as possible without exceeding the Euler fit's worst angle for that joint.
+//     The same with w rebuilt (clip.w_rebuilt, joint.quat_w_rebuilt): x, y, z of the w >= 0
+//     hemisphere fitted, w = sqrt(max(0, 1 - x^2 - y^2 - z^2)); x, y, z jump where the
+//     continuous w crosses 0 (w_crossing_joints counts the joints that ever do).
 //  3. Keys (sum over channels), key times shared per joint (distinct key frames over a joint's
 //     rotation channels), and as the reference what offline::encode ships for the rotation
 //     channels at the same settings (its world-space rounds tighten the budgets).
@@ -155,11 +158,13 @@ struct JointProbe {
   uint64_t euler_keys = 0, euler_union = 0;
   double euler_err = 0.0;     // radians
   double budget_sum = 0.0;    // radians: the sum of its rotation channels' budgets
-  // Quaternion, one round, at the chosen t
-  uint64_t quat_keys = 0, quat_union = 0;
-  double quat_err = 0.0, t = 0.0;
-  int fits = 0;               // quaternion fits tried
-  bool matched = true;        // a t with quat_err <= euler_err was found
+  // Quaternion, one round, at the chosen t: 4 components (w stored), and 3 (w rebuilt)
+  struct Choice {
+    uint64_t keys = 0, union_times = 0;
+    double err = 0.0, t = 0.0;
+    int fits = 0;             // fits tried
+    bool matched = true;      // a t with err <= euler_err was found
+  } q4, q3;
   bool still = false;         // its rotation is the same at every frame
   bool w_crosses = false;     // the sign-continuous w changes sign
   // The encoder's output
@@ -234,58 +239,70 @@ struct QuatFit {
   double err = 0.0;
 };
 
-// The 4 components of `q` fitted at tolerance t, played back, normalized and measured.
-QuatFit fit_quaternion(const keyanim::Skeleton& s, const std::vector<Quat>& q, double t, ko::FitScratch& scratch) {
-  const uint32_t frames = uint32_t(q.size());
-  const ko::Budgets budgets(s, std::vector<double>(4, t), frames);
-  std::vector<ko::EncodedChannel> chans(4);
-  std::vector<std::vector<double>> played(4);
+// How a joint's quaternion is stored: 4 sign-continuous components, or x, y, z of the w >= 0
+// hemisphere with w rebuilt as sqrt(max(0, 1 - x^2 - y^2 - z^2)) (x, y, z then jump where the
+// continuous w crosses 0).
+enum class QuatForm { w_stored, w_rebuilt };
+
+// The components of `q` (sign-continuous) in `form` fitted at tolerance t, played back,
+// normalized and measured against q.
+QuatFit fit_quaternion(const keyanim::Skeleton& s, const std::vector<Quat>& q, QuatForm form, double t,
+                       ko::FitScratch& scratch) {
+  const uint32_t frames = uint32_t(q.size()), n = form == QuatForm::w_stored ? 4 : 3;
+  const ko::Budgets budgets(s, std::vector<double>(n, t), frames);
+  std::vector<ko::EncodedChannel> chans(n);
+  std::vector<std::vector<double>> played(n);
   QuatFit r;
-  for (uint32_t k = 0; k < 4; ++k) {
-    for (uint32_t f = 0; f < frames; ++f) scratch.y[f] = q[f][k];
+  std::vector<const ko::EncodedChannel*> ptrs;
+  for (uint32_t k = 0; k < n; ++k) {
+    for (uint32_t f = 0; f < frames; ++f)
+      scratch.y[f] = form == QuatForm::w_rebuilt && q[f][3] < 0.0 ? -q[f][k] : q[f][k];
     chans[k] = fit_once(budgets, k, scratch);
     played[k] = play(chans[k], frames);
     check_keys(chans[k], scratch.y, played[k], "quaternion component " + std::to_string(k));
     r.keys += chans[k].frames.size();
+    ptrs.push_back(&chans[k]);
   }
-  r.union_times = union_frames({&chans[0], &chans[1], &chans[2], &chans[3]}).size();
-  for (uint32_t f = 0; f < frames; ++f)
-    r.err = std::max(r.err, angle(q[f], normalized({played[0][f], played[1][f], played[2][f], played[3][f]})));
+  r.union_times = union_frames(ptrs).size();
+  for (uint32_t f = 0; f < frames; ++f) {
+    Quat p{played[0][f], played[1][f], played[2][f], 0.0};
+    p[3] = n == 4 ? played[3][f] : std::sqrt(std::max(0.0, 1.0 - p[0] * p[0] - p[1] * p[1] - p[2] * p[2]));
+    r.err = std::max(r.err, angle(q[f], normalized(p)));
+  }
   return r;
 }
 
-void keep(JointProbe& p, const QuatFit& r, double t) {
-  p.quat_keys = r.keys, p.quat_union = r.union_times, p.quat_err = r.err, p.t = t;
+void keep(JointProbe::Choice& c, const QuatFit& r, double t) {
+  c.keys = r.keys, c.union_times = r.union_times, c.err = r.err, c.t = t;
 }
 
 // The largest t found whose fit is within the Euler fit's worst angle: a bracket [lo, hi]
 // (lo within, hi over), then geometric bisection; the within fit with the largest error is kept.
-void match_quaternion(const keyanim::Skeleton& s, const std::vector<Quat>& q, JointProbe& p, ko::FitScratch& scratch) {
-  p.still = std::all_of(q.begin(), q.end(), [&](const Quat& x) { return x == q[0]; });
-  p.w_crosses = std::any_of(q.begin(), q.end(), [](const Quat& x) { return x[3] < 0.0; }) &&
-                std::any_of(q.begin(), q.end(), [](const Quat& x) { return x[3] > 0.0; });
+void match_quaternion(const keyanim::Skeleton& s, const std::vector<Quat>& q, QuatForm form, JointProbe& p,
+                      ko::FitScratch& scratch) {
+  JointProbe::Choice& c = form == QuatForm::w_stored ? p.q4 : p.q3;
   const double target = p.euler_err;
   auto within = [&](double t) {
-    const QuatFit r = fit_quaternion(s, q, t, scratch);
-    ++p.fits;
+    const QuatFit r = fit_quaternion(s, q, form, t, scratch);
+    ++c.fits;
     const bool ok = r.err <= target;
-    if (ok && (p.t == 0.0 || r.err > p.quat_err)) keep(p, r, t);
+    if (ok && (c.t == 0.0 || r.err > c.err)) keep(c, r, t);
     return ok;
   };
   if (p.still || !(target > 0.0)) {
     // Nothing to match: the joint as the fitter takes it, at a quarter of its Euler budget in
     // radians (a component off by t moves the rotation by at most about 4 t).
     const double t = p.budget_sum / 3.0 / 4.0;
-    keep(p, fit_quaternion(s, q, t, scratch), t);
-    p.matched = p.quat_err <= target;
-    ++p.fits;
+    keep(c, fit_quaternion(s, q, form, t, scratch), t);
+    c.matched = c.err <= target;
+    ++c.fits;
     return;
   }
   double lo = target / 8.0, hi = target;
   while (!within(lo) && lo > target * 1e-6) hi = lo, lo /= 8.0;
-  if (p.t == 0.0) {  // never within: keep the finest fit tried, flagged
-    keep(p, fit_quaternion(s, q, lo, scratch), lo);
-    p.matched = false;
+  if (c.t == 0.0) {  // never within: keep the finest fit tried, flagged
+    keep(c, fit_quaternion(s, q, form, lo, scratch), lo);
+    c.matched = false;
     return;
   }
   while (within(hi) && hi < target * 64.0) lo = hi, hi *= 2.0;
@@ -353,13 +370,16 @@ std::vector<CorpusClip> find_clips(const fs::path& corpus, const std::string& fi
 }
 
 json joint_json(const keyanim::Skeleton& s, const JointProbe& p) {
-  return {{"name", s.joints[p.node].name}, {"euler_keys", p.euler_keys}, {"quat_keys", p.quat_keys},
-          {"euler_union_times", p.euler_union}, {"quat_union_times", p.quat_union},
+  constexpr double deg = 180.0 / std::numbers::pi;
+  auto choice = [&](const JointProbe::Choice& c) {
+    return json{{"keys", c.keys}, {"union_times", c.union_times}, {"err_deg", c.err * deg}, {"t", c.t},
+                {"fits", c.fits}, {"matched", c.matched}};
+  };
+  return {{"name", s.joints[p.node].name}, {"euler_keys", p.euler_keys}, {"quat_keys", p.q4.keys},
+          {"euler_union_times", p.euler_union}, {"quat_union_times", p.q4.union_times},
           {"encoder_keys", p.encoder_keys}, {"encoder_union_times", p.encoder_union},
-          {"euler_err_deg", p.euler_err * 180.0 / std::numbers::pi},
-          {"quat_err_deg", p.quat_err * 180.0 / std::numbers::pi},
-          {"budget_sum_deg", p.budget_sum * 180.0 / std::numbers::pi}, {"t", p.t}, {"fits", p.fits},
-          {"matched", p.matched}, {"still", p.still}, {"w_crosses_0", p.w_crosses}};
+          {"euler_err_deg", p.euler_err * deg}, {"budget_sum_deg", p.budget_sum * deg},
+          {"quat", choice(p.q4)}, {"quat_w_rebuilt", choice(p.q3)}, {"still", p.still}, {"w_crosses_0", p.w_crosses}};
 }
 
 double ratio(uint64_t a, uint64_t b) { return b ? double(a) / double(b) : 0.0; }
@@ -380,16 +400,25 @@ json probe_clip(const CorpusClip& c, unsigned threads) {
                        std::to_string(p.euler_err) + " rad, more than its budgets' sum " + std::to_string(p.budget_sum));
   std::vector<ko::FitScratch> scratch(ko::parallel_workers(joints.size(), threads));
   for (ko::FitScratch& s : scratch) s.prepare(m.frame_count), s.y.resize(m.frame_count);
-  ko::parallel_for(joints.size(), threads,
-                   [&](size_t i, unsigned w) { match_quaternion(m.skeleton, orig[i], joints[i], scratch[w]); });
+  ko::parallel_for(joints.size(), threads, [&](size_t i, unsigned w) {
+    JointProbe& p = joints[i];
+    const std::vector<Quat>& q = orig[i];
+    p.still = std::all_of(q.begin(), q.end(), [&](const Quat& x) { return x == q[0]; });
+    p.w_crosses = std::any_of(q.begin(), q.end(), [](const Quat& x) { return x[3] < 0.0; }) &&
+                  std::any_of(q.begin(), q.end(), [](const Quat& x) { return x[3] > 0.0; });
+    match_quaternion(m.skeleton, q, QuatForm::w_stored, p, scratch[w]);
+    match_quaternion(m.skeleton, q, QuatForm::w_rebuilt, p, scratch[w]);
+  });
   encoder_reference(m, threads, tol_units, shell, joints);
 
   uint64_t ek = 0, qk = 0, eu = 0, qu = 0, rk = 0, ru = 0, unmatched = 0, still = 0, crossing = 0;
+  uint64_t q3k = 0, q3u = 0, unmatched3 = 0;
   json detail = json::array();
   for (const JointProbe& p : joints) {
-    ek += p.euler_keys, qk += p.quat_keys, eu += p.euler_union, qu += p.quat_union;
+    ek += p.euler_keys, qk += p.q4.keys, eu += p.euler_union, qu += p.q4.union_times;
+    q3k += p.q3.keys, q3u += p.q3.union_times, unmatched3 += !p.q3.matched;
     rk += p.encoder_keys, ru += p.encoder_union;
-    unmatched += !p.matched, still += p.still, crossing += p.w_crosses;
+    unmatched += !p.q4.matched, still += p.still, crossing += p.w_crosses;
     detail.push_back(joint_json(m.skeleton, p));
   }
   const double seconds = double(m.frame_count) * m.frame_time;
@@ -400,6 +429,8 @@ json probe_clip(const CorpusClip& c, unsigned threads) {
           {"encoder_rotation_keys", rk}, {"encoder_over_euler_keys", ratio(rk, ek)},
           {"encoder_rotation_union_times", ru}, {"unmatched_joints", unmatched}, {"still_joints", still},
           {"w_crossing_joints", crossing},
+          {"w_rebuilt", {{"quat_keys", q3k}, {"quat_over_euler", ratio(q3k, ek)}, {"quat_union_times", q3u},
+                         {"union_quat_over_euler", ratio(q3u, eu)}, {"unmatched_joints", unmatched3}}},
           {"probe_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
           {"joints_detail", detail}};
 }
@@ -419,13 +450,16 @@ json spread(std::vector<double> v) {
 json summarize(const json& clips) {
   json groups = json::object();
   for (const char* g : {"cmu120", "bandai30"}) {
-    std::vector<double> qe, ue, re;
+    std::vector<double> qe, ue, re, q3e, u3e;
     double joint_seconds = 0;
     uint64_t ek = 0, qk = 0, eu = 0, qu = 0, rk = 0, unmatched = 0, crossing = 0, joints = 0;
+    uint64_t q3k = 0, unmatched3 = 0;
     for (const json& c : clips) {
       if (c["group"] != g) continue;
       qe.push_back(c["quat_over_euler"]), ue.push_back(c["union_quat_over_euler"]);
       re.push_back(c["encoder_over_euler_keys"]);
+      q3e.push_back(c["w_rebuilt"]["quat_over_euler"]), u3e.push_back(c["w_rebuilt"]["union_quat_over_euler"]);
+      q3k += c["w_rebuilt"]["quat_keys"].get<uint64_t>(), unmatched3 += c["w_rebuilt"]["unmatched_joints"].get<uint64_t>();
       joint_seconds += c["joints"].get<double>() * c["seconds"].get<double>();
       ek += c["euler_keys"].get<uint64_t>(), qk += c["quat_keys"].get<uint64_t>();
       eu += c["euler_union_times"].get<uint64_t>(), qu += c["quat_union_times"].get<uint64_t>();
@@ -441,7 +475,10 @@ json summarize(const json& clips) {
                  {"quat_keys_per_joint_s", double(qk) / joint_seconds},
                  {"euler_union_per_joint_s", double(eu) / joint_seconds},
                  {"quat_union_per_joint_s", double(qu) / joint_seconds},
-                 {"encoder_keys_per_joint_s", double(rk) / joint_seconds}};
+                 {"encoder_keys_per_joint_s", double(rk) / joint_seconds},
+                 {"w_rebuilt", {{"quat_over_euler", spread(q3e)}, {"union_quat_over_euler", spread(u3e)},
+                                {"quat_keys", q3k}, {"quat_keys_per_joint_s", double(q3k) / joint_seconds},
+                                {"unmatched_joints", unmatched3}}}};
   }
   return groups;
 }
@@ -465,6 +502,14 @@ void print_table(const json& clips, const json& groups) {
                 x["encoder_over_euler_keys"]["median"].get<double>(), x["encoder_over_euler_keys"]["min"].get<double>(),
                 x["encoder_over_euler_keys"]["max"].get<double>(), x["euler_keys_per_joint_s"].get<double>(),
                 x["quat_keys_per_joint_s"].get<double>());
+  for (const auto& [g, x] : groups.items())
+    std::printf("%s, w rebuilt: quat/euler keys median %.3f max %.3f; union median %.3f max %.3f; joints crossing "
+                "w = 0: %llu of %llu\n",
+                g.c_str(), x["w_rebuilt"]["quat_over_euler"]["median"].get<double>(),
+                x["w_rebuilt"]["quat_over_euler"]["max"].get<double>(),
+                x["w_rebuilt"]["union_quat_over_euler"]["median"].get<double>(),
+                x["w_rebuilt"]["union_quat_over_euler"]["max"].get<double>(),
+                (unsigned long long)x["w_crossing_joints"].get<uint64_t>(), (unsigned long long)x["joints"].get<uint64_t>());
 }
 
 struct Options {
