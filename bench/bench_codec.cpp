@@ -364,7 +364,8 @@ int bench_main(int argc, char** argv) {
     out["speedup_2threads"] = out["long_clips"].value("speedup_2threads", 0.0);
     out["peak_rss_over_bvh_bytes"] = out["long_clips"].value("peak_rss_over_bvh_bytes", 0.0);
   }
-  out["targets"] = {{"encode_over_parse_1thread", "<= 20"}, {"speedup_2threads", ">= 1.7"}, {"peak_rss_over_bvh_bytes", "<= 3"}};
+  // Issue 24's targets (the earlier encode_over_parse goal was 20).
+  out["targets"] = {{"encode_over_parse_1thread", "<= 25"}, {"speedup_2threads", ">= 1.7"}, {"peak_rss_over_bvh_bytes", "<= 3"}};
   std::cout << out.dump(1) << "\n";
   return 0;
 }
