@@ -1,5 +1,5 @@
 // Sine and cosine of half an angle given in degrees, for Euler-to-quaternion conversion: four
-// angles at a time (F4: SSE2), and a scalar twin that performs the same binary32 operations
+// angles at a time (F4: SSE2), eight (F8: the AVX2 copies), and a scalar twin that performs the same binary32 operations
 // (so both give identical results). Accurate to about 1 ulp for the angles motion capture
 // holds (|angle| < 10^6 degrees): the angle is reduced by multiples of 90 degrees exactly
 // before it is converted to radians, and the polynomials are Cephes' sinf/cosf on [-pi/4, pi/4].
@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "internal/simd.h"
+#include "internal/simd8.h"
 
 namespace keyanim::internal {
 
@@ -61,6 +62,44 @@ inline void half_sincos_deg(F4 deg, F4& s, F4& c) noexcept {
 #else
 inline void half_sincos_deg(F4 deg, F4& s, F4& c) noexcept {
   for (int i = 0; i < 4; ++i) half_sincos_deg(deg.v[i], s.v[i], c.v[i]);
+}
+#endif
+
+#if KEYANIM_WIDE_LANES
+// cvtps2dq (F4's quadrant) in generic vector code: round to nearest even of |x| by adding and
+// subtracting 2^23 (exact below 2^23; from there on every binary32 is an integer), the sign
+// put back, and INT32_MIN where x is outside int32's range or NaN, as cvtps2dq gives.
+KEYANIM_INLINE inline V8i round_to_int32(V8f x) noexcept {
+  const V8i sign_bit = I8::splat(INT32_MIN).v;
+  const V8f two23 = F8(8388608.0f).v;
+  const V8f ax = V8f(V8i(x) & ~sign_bit);
+  const V8i small = ax < two23;
+  const V8f rounded = V8f(V8i((ax + two23) - two23) | (V8i(x) & sign_bit));
+  const V8f r = V8f((small & V8i(rounded)) | (~small & V8i(x)));
+  const V8i in_range = (r >= F8(-2147483648.0f).v) & (r < F8(2147483648.0f).v);
+  const V8i q = __builtin_convertvector(V8f(in_range & V8i(r)), V8i);  // in range: exact (r is whole)
+  return (in_range & q) | (~in_range & sign_bit);
+}
+
+// Eight angles at once: the F4 twin's operations, in its order, lane by lane.
+KEYANIM_INLINE inline void half_sincos_deg(F8 deg, F8& s, F8& c) noexcept {
+  const V8i one = I8::splat(1).v, two = I8::splat(2).v, sign = I8::splat(INT32_MIN).v;
+  const V8f h = deg.v * F8(0.5f).v;
+  const V8i q = round_to_int32(h * F8(1.0f / 90.0f).v);
+  const V8f k = __builtin_convertvector(q, V8f);
+  const V8f x = (h - k * F8(90.0f).v) * F8(kRadPerDeg).v;
+  const V8f z = x * x;
+  V8f sp = F8(-1.9515295891e-4f).v * z + F8(8.3321608736e-3f).v;
+  sp = sp * z - F8(1.6666654611e-1f).v;
+  sp = sp * z * x + x;
+  V8f cp = F8(2.443315711809948e-5f).v * z - F8(1.388731625493765e-3f).v;
+  cp = cp * z + F8(4.166664568298827e-2f).v;
+  cp = (cp * z * z - F8(0.5f).v * z) + F8(1.0f).v;
+  const V8i swap = (q & one) == one;
+  const V8i a = (swap & V8i(cp)) | (~swap & V8i(sp));
+  const V8i b = (swap & V8i(sp)) | (~swap & V8i(cp));
+  s = F8(V8f(a ^ (((q & two) == two) & sign)));
+  c = F8(V8f(b ^ ((((q + one) & two) == two) & sign)));
 }
 #endif
 

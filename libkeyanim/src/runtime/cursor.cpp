@@ -8,6 +8,7 @@
 
 #include "internal/cpu.h"
 #include "internal/simd.h"
+#include "internal/simd8.h"
 #include "runtime/clip_access.h"
 #include "runtime/cursor_state.h"
 
@@ -25,8 +26,9 @@ Status Cursor::prepare(const Clip& clip) noexcept {
     auto st = std::make_unique<State>();
     const Image& img = ClipAccess::image(clip);
     st->image = ClipAccess::shared(clip);
-    // Rounded up to whole SIMD lanes; an empty range (lo = +inf) makes every curve refresh.
-    const size_t n = (img.curves.size() + 3) & ~size_t(3);
+    // Rounded up to whole SIMD lanes (8: the AVX2 copy's); an empty range (lo = +inf) makes
+    // every curve refresh.
+    const size_t n = (img.curves.size() + 7) & ~size_t(7);
     for (auto* v : {&st->hi, &st->k0, &st->p0, &st->d, &st->m0, &st->m1, &st->value, &st->result}) v->assign(n, 0.0f);
     st->lo.assign(n, std::numeric_limits<float>::infinity());
     st->k1.assign(n, 1.0f);
@@ -94,6 +96,16 @@ void refresh(const Image& img, Cursor::State& st, uint32_t i, float f) noexcept 
   }
 }
 
+// Every state's value at f, for the lanes of one V (F4: 4, F8: 8) from i.
+template <class V>
+KEYANIM_INLINE inline void evaluate_states(Cursor::State& st, const V& f, uint32_t i) noexcept {
+  const V u = segment_u(f, V::load(&st.k0[i]), V::load(&st.k1[i]));
+  const Operands<V> o{V::load(&st.p0[i]), V::load(&st.d[i]), V::load(&st.m0[i]), V::load(&st.m1[i])};
+  const V v = select(V::load_mask(&st.linear[i]), linear_value(o.p0, o.d, u), hermite(o, u));
+  select(V::load_mask(&st.direct[i]), V::load(&st.value[i]), v).store(&st.result[i]);
+}
+
+template <bool kWide>
 KEYANIM_INLINE inline void playback_impl(const Image& img, Cursor::State& st, float f, float* out) noexcept {
   const uint32_t n = static_cast<uint32_t>(img.curves.size());
   const F4 fv(f);
@@ -105,23 +117,25 @@ KEYANIM_INLINE inline void playback_impl(const Image& img, Cursor::State& st, fl
       if (c < n) refresh(img, st, c, f);
     }
   }
-  for (uint32_t i = 0; i < n; i += 4) {
-    const F4 u = segment_u(fv, F4::load(&st.k0[i]), F4::load(&st.k1[i]));
-    const Operands<F4> o{F4::load(&st.p0[i]), F4::load(&st.d[i]), F4::load(&st.m0[i]), F4::load(&st.m1[i])};
-    const F4 v = select(F4::load_mask(&st.linear[i]), linear_value(o.p0, o.d, u), hermite(o, u));
-    select(F4::load_mask(&st.direct[i]), F4::load(&st.value[i]), v).store(&st.result[i]);
+  uint32_t i = 0;
+#if KEYANIM_WIDE_LANES
+  if constexpr (kWide) {  // the states are padded to 8 lanes (Cursor::prepare)
+    const F8 f8(f);
+    for (; i < n; i += 8) evaluate_states(st, f8, i);
   }
+#endif
+  for (; i < n; i += 4) evaluate_states(st, fv, i);
   const uint32_t* channel = img.curve_channel.data();
-  for (uint32_t i = 0; i < n; ++i) out[channel[i]] = st.result[i];
+  for (uint32_t c = 0; c < n; ++c) out[channel[c]] = st.result[c];
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
 }
 
-// One copy per CPU level (internal/cpu.h).
+// One copy per CPU level (internal/cpu.h), 8 lanes at v3.
 KEYANIM_V3_TARGET void playback_v3(const Image& img, Cursor::State& st, float f, float* out) noexcept {
-  playback_impl(img, st, f, out);
+  playback_impl<KEYANIM_WIDE_LANES != 0>(img, st, f, out);
 }
 void playback_plain(const Image& img, Cursor::State& st, float f, float* out) noexcept {
-  playback_impl(img, st, f, out);
+  playback_impl<false>(img, st, f, out);
 }
 
 }  // namespace

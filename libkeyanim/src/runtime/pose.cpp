@@ -14,9 +14,11 @@
 namespace keyanim::internal {
 namespace {
 
-// Four nodes' rotations, one component per register: lane i is node i's quaternion.
-struct Quat4 {
-  F4 x, y, z, w;
+// Four (F4) or eight (F8: the AVX2 copy) nodes' rotations, one component per register: lane i
+// is node i's quaternion.
+template <class V>
+struct QuatLanes {
+  V x, y, z, w;
 };
 
 // q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w):
@@ -24,8 +26,9 @@ struct Quat4 {
 //   X: (x c + w s, y c + z s, z c - y s, w c - x s)
 //   Y: (x c - z s, y c + w s, z c + x s, w c - y s)
 //   Z: (x c + y s, y c - x s, z c + w s, w c - z s).
-// The axis is the same in every lane (a group's), so the choice is made once for four nodes.
-KEYANIM_INLINE inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c) noexcept {
+// The axis is the same in every lane (a group's), so the choice is made once for all lanes.
+template <class V>
+KEYANIM_INLINE inline QuatLanes<V> rotate_by(const QuatLanes<V>& q, uint32_t axis, const V& s, const V& c) noexcept {
   switch (axis) {
     case 0: return {q.x * c + q.w * s, q.y * c + q.z * s, q.z * c - q.y * s, q.w * c - q.x * s};
     case 1: return {q.x * c - q.z * s, q.y * c + q.w * s, q.z * c + q.x * s, q.w * c - q.y * s};
@@ -33,24 +36,68 @@ KEYANIM_INLINE inline Quat4 rotate_by(const Quat4& q, uint32_t axis, F4 s, F4 c)
   }
 }
 
-// The rotations of a group's nodes [begin, end) (indices into the group), out[node - first].
+// The angles of `lanes` nodes (the rest 0) from their columns, gathered into registers.
+KEYANIM_INLINE inline F4 gather_angles(const F4*, const float* values, const uint32_t* column, uint32_t column0,
+                                       uint32_t lanes) noexcept {
+  auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
+  return F4::set(angle(0), angle(1), angle(2), angle(3));
+}
+#if KEYANIM_WIDE_LANES
+KEYANIM_INLINE inline F8 gather_angles(const F8*, const float* values, const uint32_t* column, uint32_t column0,
+                                       uint32_t lanes) noexcept {
+  auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
+  return F8(V8f{angle(0), angle(1), angle(2), angle(3), angle(4), angle(5), angle(6), angle(7)});
+}
+#endif
+
+// Each lane's quaternion to its node's Transform, out[node - first].
+KEYANIM_INLINE inline void store_rotations(QuatLanes<F4> q, const uint32_t* node, uint32_t first, uint32_t lanes,
+                                           Transform* out) noexcept {
+  transpose(q.x, q.y, q.z, q.w);  // now lane rows: node 0's (x, y, z, w) in q.x, node 1's in q.y, ...
+  const F4* row[4] = {&q.x, &q.y, &q.z, &q.w};
+  for (uint32_t l = 0; l < lanes; ++l) row[l]->store(out[node[l] - first].rotation);
+}
+#if KEYANIM_WIDE_LANES
+KEYANIM_INLINE inline void store_rotations(const QuatLanes<F8>& q, const uint32_t* node, uint32_t first,
+                                           uint32_t lanes, Transform* out) noexcept {
+  store_rotations(QuatLanes<F4>{q.x.low(), q.y.low(), q.z.low(), q.w.low()}, node, first, std::min(lanes, 4u), out);
+  if (lanes > 4)
+    store_rotations(QuatLanes<F4>{q.x.high(), q.y.high(), q.z.high(), q.w.high()}, node + 4, first, lanes - 4, out);
+}
+#endif
+
+// The rotations of `lanes` nodes of a group from its node i, in the registers of one V.
+template <class V>
+KEYANIM_INLINE inline void lane_rotations(const Rig& rig, const Rig::RotationGroup& g, uint32_t i, uint32_t lanes,
+                                          const float* values, uint32_t column0, uint32_t first,
+                                          Transform* out) noexcept {
+  QuatLanes<V> q{V(0.0f), V(0.0f), V(0.0f), V(1.0f)};
+  for (uint32_t k = 0; k < g.steps; ++k) {
+    const uint32_t* column = rig.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
+    V s, c;
+    half_sincos_deg(gather_angles(static_cast<const V*>(nullptr), values, column, column0, lanes), s, c);
+    q = rotate_by(q, g.axis[k], s, c);
+  }
+  store_rotations(q, rig.group_node.data() + g.node_first + i, first, lanes, out);
+}
+
+// The rotations of a group's nodes [begin, end) (indices into the group), out[node - first]:
+// 8 at a time when kWide while more than 4 are left, then 4.
+template <bool kWide>
 KEYANIM_INLINE inline void group_rotations(const Rig& rig, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
                                            const float* values, uint32_t column0, uint32_t first,
                                            Transform* out) noexcept {
-  const uint32_t* node = rig.group_node.data() + g.node_first;
-  for (uint32_t i = begin; i < end; i += 4) {
-    const uint32_t lanes = std::min(4u, end - i);
-    Quat4 q{F4(0.0f), F4(0.0f), F4(0.0f), F4(1.0f)};
-    for (uint32_t k = 0; k < g.steps; ++k) {
-      const uint32_t* column = rig.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
-      auto angle = [&](uint32_t l) { return l < lanes ? values[column[l] - column0] : 0.0f; };
-      F4 s, c;
-      half_sincos_deg(F4::set(angle(0), angle(1), angle(2), angle(3)), s, c);
-      q = rotate_by(q, g.axis[k], s, c);
+  for (uint32_t i = begin; i < end;) {
+    const uint32_t left = end - i;
+#if KEYANIM_WIDE_LANES
+    if (kWide && left > 4) {
+      lane_rotations<F8>(rig, g, i, std::min(8u, left), values, column0, first, out);
+      i += 8;
+      continue;
     }
-    transpose(q.x, q.y, q.z, q.w);  // now lane rows: node i's (x, y, z, w) in q.x, i + 1's in q.y, ...
-    const F4* row[4] = {&q.x, &q.y, &q.z, &q.w};
-    for (uint32_t l = 0; l < lanes; ++l) row[l]->store(out[node[i + l] - first].rotation);
+#endif
+    lane_rotations<F4>(rig, g, i, std::min(4u, left), values, column0, first, out);
+    i += 4;
   }
 }
 
@@ -109,6 +156,7 @@ KEYANIM_INLINE inline void multiply(const float* a, const float* b, float* out) 
 static_assert(offsetof(Transform, reserved) == offsetof(Transform, translation) + 3 * sizeof(float),
               "a node's translation and reserved are one 4-float copy of Rig::node_offset");
 
+template <bool kWide>
 KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t last, const float* values,
                                      PositionReading reading, Transform* out) noexcept {
   const Rig& rig = *img.rig;
@@ -128,7 +176,7 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
   for (const Rig::RotationGroup& g : rig.rot_groups) {
     const uint32_t* node = rig.group_node.data() + g.node_first;
     const uint32_t begin = lower_index(node, g.node_count, first), end = lower_index(node, g.node_count, last);
-    group_rotations(rig, g, begin, end, values, column0, first, out);
+    group_rotations<kWide>(rig, g, begin, end, values, column0, first, out);
   }
 }
 
@@ -155,14 +203,14 @@ KEYANIM_INLINE inline void compose_impl(const Image& img, Transform* out) noexce
   }
 }
 
-// One copy per CPU level (internal/cpu.h).
+// One copy per CPU level (internal/cpu.h), 8 lanes at v3.
 KEYANIM_V3_TARGET void local_v3(const Image& img, uint32_t first, uint32_t last, const float* values,
                                 PositionReading reading, Transform* out) noexcept {
-  local_impl(img, first, last, values, reading, out);
+  local_impl<KEYANIM_WIDE_LANES != 0>(img, first, last, values, reading, out);
 }
 void local_plain(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
                  Transform* out) noexcept {
-  local_impl(img, first, last, values, reading, out);
+  local_impl<false>(img, first, last, values, reading, out);
 }
 KEYANIM_V3_TARGET void compose_v3(const Image& img, Transform* out) noexcept { compose_impl(img, out); }
 void compose_plain(const Image& img, Transform* out) noexcept { compose_impl(img, out); }

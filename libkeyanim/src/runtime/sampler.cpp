@@ -1,8 +1,8 @@
 // Sampling the runtime image. Two passes over chunks of channels: a scalar pass reads each
 // curve's record (image.h: read_window) into its four key frames and dequantized values, then
-// a SIMD pass evaluates Appendix A with cardinal.h's building blocks 4 channels at a time.
-// Both passes compute exactly Appendix A, so every value is bit-identical to eval_channel's
-// (tests check every channel of every test vector and corpus clip).
+// a SIMD pass evaluates Appendix A with cardinal.h's building blocks 4 channels at a time (8 in
+// the AVX2 copy: internal/simd8.h). Both passes compute exactly Appendix A, so every value is
+// bit-identical to eval_channel's (tests check every channel of every test vector and corpus clip).
 #include "runtime/sampler.h"
 
 #include <algorithm>
@@ -12,6 +12,7 @@
 
 #include "internal/cpu.h"
 #include "internal/simd.h"
+#include "internal/simd8.h"
 
 namespace keyanim::internal {
 namespace {
@@ -174,41 +175,71 @@ void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept
   b.linear[i] = img.curve_linear[curve];
 }
 
-// Pass two: Appendix A for lanes [0, count) rounded up to 4. The frames and values of 4 lanes
-// are transposed into k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2} vectors.
-template <bool kAdjusted>
-KEYANIM_INLINE inline void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count,
-                                   float* res) noexcept {
-  const F4 f(at.f), rel(at.rel);
-  for (uint32_t i = 0; i < count; i += 4) {
-    I4 km = I4::load(b.frames[i]), kj = I4::load(b.frames[i + 1]), kp = I4::load(b.frames[i + 2]),
-       kp2 = I4::load(b.frames[i + 3]);
-    transpose(km, kj, kp, kp2);
-    F4 pm = F4::load(b.values[i]), p0 = F4::load(b.values[i + 1]), p1 = F4::load(b.values[i + 2]),
-       p2 = F4::load(b.values[i + 3]);
-    transpose(pm, p0, p1, p2);
-    // Lengths rounded once from the integer differences, as Appendix A; the uniform rule is
-    // the step-adjusted one with equal lengths (tangent_scale then gives exactly 1).
-    const F4 k0 = to_float(kj), k1 = to_float(kp), len = to_float(kp - kj);
-    const F4 a0 = kAdjusted ? tangent_scale(len, to_float(kj - km)) : F4(1.0f);
-    const F4 a1 = kAdjusted ? tangent_scale(len, to_float(kp2 - kp)) : F4(1.0f);
-    const F4 u = segment_u(rel, k0, k1);
-    const Operands<F4> o = cardinal_operands(pm, p0, p1, p2, F4::load(x.s + i), a0, a1);
-    const F4 value = select(F4::load_mask(x.linear + i), linear_value(o.p0, o.d, u), hermite(o, u));
-    // Appendix A's cases: f <= K_0 gives v_0, f >= K_{n-1} gives v_{n-1}, f == K_j gives v_j.
-    const F4 before = cmp_not_gt(f, F4::load(x.first_frame + i));
-    const F4 after = cmp_ge(f, F4::load(x.last_frame + i));
-    const F4 direct = select(before, F4::load(x.first_value + i), select(after, F4::load(x.last_value + i), p0));
-    select(mask_or(mask_or(before, after), cmp_eq(rel, k0)), direct, value).store(res + i);
-  }
+// Pass two's loads of one group of lanes from i: the frames and values of each lane's four
+// keys, transposed into k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2} vectors.
+KEYANIM_INLINE inline void load_keys(const Batch& b, uint32_t i, I4 (&k)[4], F4 (&p)[4]) noexcept {
+  for (int r = 0; r < 4; ++r) k[r] = I4::load(b.frames[i + r]), p[r] = F4::load(b.values[i + r]);
+  transpose(k[0], k[1], k[2], k[3]);
+  transpose(p[0], p[1], p[2], p[3]);
+}
+#if KEYANIM_WIDE_LANES
+KEYANIM_INLINE inline void load_keys(const Batch& b, uint32_t i, I8 (&k)[4], F8 (&p)[4]) noexcept {
+  I4 klo[4], khi[4];
+  F4 plo[4], phi[4];
+  load_keys(b, i, klo, plo), load_keys(b, i + 4, khi, phi);
+  for (int r = 0; r < 4; ++r) k[r] = I8::join(klo[r], khi[r]), p[r] = F8::join(plo[r], phi[r]);
+}
+#endif
+template <class V> struct IntLanes;
+template <> struct IntLanes<F4> { using type = I4; };
+#if KEYANIM_WIDE_LANES
+template <> struct IntLanes<F8> { using type = I8; };
+#endif
+
+// Appendix A for the lanes of one V (F4: 4, F8: 8) from lane i.
+template <class V, bool kAdjusted>
+KEYANIM_INLINE inline void evaluate_lanes(const Batch& b, const Facts& x, const V& f, const V& rel, uint32_t i, float* res) noexcept {
+  typename IntLanes<V>::type k[4];
+  V p[4];
+  load_keys(b, i, k, p);
+  // Lengths rounded once from the integer differences, as Appendix A; the uniform rule is
+  // the step-adjusted one with equal lengths (tangent_scale then gives exactly 1).
+  const V k0 = to_float(k[1]), k1 = to_float(k[2]), len = to_float(k[2] - k[1]);
+  const V a0 = kAdjusted ? tangent_scale(len, to_float(k[1] - k[0])) : V(1.0f);
+  const V a1 = kAdjusted ? tangent_scale(len, to_float(k[3] - k[2])) : V(1.0f);
+  const V u = segment_u(rel, k0, k1);
+  const Operands<V> o = cardinal_operands(p[0], p[1], p[2], p[3], V::load(x.s + i), a0, a1);
+  const V value = select(V::load_mask(x.linear + i), linear_value(o.p0, o.d, u), hermite(o, u));
+  // Appendix A's cases: f <= K_0 gives v_0, f >= K_{n-1} gives v_{n-1}, f == K_j gives v_j.
+  const V before = cmp_not_gt(f, V::load(x.first_frame + i));
+  const V after = cmp_ge(f, V::load(x.last_frame + i));
+  const V direct = select(before, V::load(x.first_value + i), select(after, V::load(x.last_value + i), p[1]));
+  select(mask_or(mask_or(before, after), cmp_eq(rel, k0)), direct, value).store(res + i);
 }
 
+// Pass two: Appendix A for lanes [0, count), count a multiple of 4; 8 lanes at a time when
+// kWide (the v3 copy), the last 4 if any on their own (the facts arrays are padded to 4).
+template <bool kAdjusted, bool kWide>
+KEYANIM_INLINE inline void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count,
+                                   float* res) noexcept {
+  uint32_t i = 0;
+#if KEYANIM_WIDE_LANES
+  if constexpr (kWide) {
+    const F8 f(at.f), rel(at.rel);
+    for (; i + 8 <= count; i += 8) evaluate_lanes<F8, kAdjusted>(b, x, f, rel, i, res);
+  }
+#endif
+  const F4 f(at.f), rel(at.rel);
+  for (; i < count; i += 4) evaluate_lanes<F4, kAdjusted>(b, x, f, rel, i, res);
+}
+
+template <bool kWide>
 KEYANIM_INLINE inline void evaluate(const Image& img, const Batch& b, const Facts& x, const Position& at,
                                    uint32_t count, float* res) noexcept {
   if (img.rule == TangentRule::step_adjusted)
-    evaluate<true>(b, x, at, count, res);
+    evaluate<true, kWide>(b, x, at, count, res);
   else
-    evaluate<false>(b, x, at, count, res);
+    evaluate<false, kWide>(b, x, at, count, res);
 }
 
 Facts batch_facts(const Batch& b) {
@@ -218,7 +249,7 @@ Facts batch_facts(const Batch& b) {
 // The two passes over chunks of `count` lanes at position f: fill(b, at, view, base, m)
 // gathers lanes [base, base + m) into b, facts(b, base) says where their per-curve facts are,
 // emit(res, base, m) writes the results.
-template <class Fill, class FactsOf, class Emit>
+template <bool kWide, class Fill, class FactsOf, class Emit>
 [[gnu::always_inline]] inline void run_chunks(const Image& img, float f, uint32_t count, Fill fill, FactsOf facts,
                                               Emit emit) noexcept {
   Batch b;
@@ -230,13 +261,13 @@ template <class Fill, class FactsOf, class Emit>
     fill(b, at, view, base, m);
     const uint32_t lanes = (m + 3) & ~3u;
     for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
-    evaluate(img, b, facts(b, base), at, lanes, res);
+    evaluate<kWide>(img, b, facts(b, base), at, lanes, res);
     emit(res, base, m);
   }
 }
 
 // The listed channels at f, out[i] for channels[i].
-template <bool kPopcnt>
+template <bool kPopcnt, bool kWide>
 [[gnu::always_inline]] inline void sample_chunks(const Image& img, float f, const uint32_t* channels, uint32_t count,
                                                  float* out) noexcept {
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
@@ -258,12 +289,12 @@ template <bool kPopcnt>
   auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
     std::memcpy(out + base, res, m * sizeof(float));
   };
-  run_chunks(img, f, count, fill, facts, emit);
+  run_chunks<kWide>(img, f, count, fill, facts, emit);
 }
 
 // Every curve in order, written to its channel; the fixed channels separately. The per-curve
 // facts are read from the image directly (the arrays are padded to whole SIMD lanes).
-template <bool kPopcnt>
+template <bool kPopcnt, bool kWide>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
@@ -285,24 +316,27 @@ template <bool kPopcnt>
     const uint32_t* channel = img.curve_channel.data() + base;
     for (uint32_t i = 0; i < m; ++i) out[channel[i]] = res[i];
   };
-  run_chunks(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
+  run_chunks<kWide>(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
 }
 
-// One copy per CPU level (internal/cpu.h); popcnt from the popcnt level on.
-KEYANIM_V3_TARGET void all_v3(const Image& img, float f, float* out) noexcept { sample_curves<true>(img, f, out); }
-KEYANIM_POPCNT_TARGET void all_popcnt(const Image& img, float f, float* out) noexcept {
-  sample_curves<true>(img, f, out);
+// One copy per CPU level (internal/cpu.h); popcnt from the popcnt level on, 8 lanes at v3.
+constexpr bool kWideAtV3 = KEYANIM_WIDE_LANES != 0;
+KEYANIM_V3_TARGET void all_v3(const Image& img, float f, float* out) noexcept {
+  sample_curves<true, kWideAtV3>(img, f, out);
 }
-void all_plain(const Image& img, float f, float* out) noexcept { sample_curves<false>(img, f, out); }
+KEYANIM_POPCNT_TARGET void all_popcnt(const Image& img, float f, float* out) noexcept {
+  sample_curves<true, false>(img, f, out);
+}
+void all_plain(const Image& img, float f, float* out) noexcept { sample_curves<false, false>(img, f, out); }
 KEYANIM_V3_TARGET void listed_v3(const Image& img, float f, const uint32_t* ch, uint32_t n, float* out) noexcept {
-  sample_chunks<true>(img, f, ch, n, out);
+  sample_chunks<true, kWideAtV3>(img, f, ch, n, out);
 }
 KEYANIM_POPCNT_TARGET void listed_popcnt(const Image& img, float f, const uint32_t* ch, uint32_t n,
                                          float* out) noexcept {
-  sample_chunks<true>(img, f, ch, n, out);
+  sample_chunks<true, false>(img, f, ch, n, out);
 }
 void listed_plain(const Image& img, float f, const uint32_t* ch, uint32_t n, float* out) noexcept {
-  sample_chunks<false>(img, f, ch, n, out);
+  sample_chunks<false, false>(img, f, ch, n, out);
 }
 
 }  // namespace
