@@ -18,15 +18,17 @@
 #                          Also left out: cli_bank_corpus (100 s: the whole corpus packed by the
 #                          CLI, whose bank writer and reader the codec round trip runs over the
 #                          same clips, and bank_test and cli_bank_* on damaged and small banks)
-#                          and cli_manifest_parallel (56 s: GNU parallel's recipe killed and
+#                          cli_manifest_parallel (56 s: GNU parallel's recipe killed and
 #                          resumed, around the encode that cli_manifest and cli_bank_manifest run)
+#                          and cli_progress (58 s: progress on a pseudo-terminal while a clip
+#                          encodes; the encoder's progress calls run in progress_test.cpp here)
 # A fuzz finding fails the script; the input is kept in build-asan/findings/<target>/ (see
 # fuzz/README.md for turning it into a committed seed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc)
 FUZZ_SECONDS=${KEYANIM_FUZZ_SECONDS:-30}
-EXCLUDE=${KEYANIM_ASAN_EXCLUDE-^(gltf_(corpus|blender)|docs_figures_corpus|readme_gltf_table_corpus|cli_hostile_gltf_(depth|rounds)|cli_bank_corpus|cli_manifest_parallel)}
+EXCLUDE=${KEYANIM_ASAN_EXCLUDE-^(gltf_(corpus|blender)|docs_figures_corpus|readme_gltf_table_corpus|cli_hostile_gltf_(depth|rounds)|cli_bank_corpus|cli_manifest_parallel|cli_progress)}
 B=build-asan
 
 CXX_FOR_ASAN=g++
