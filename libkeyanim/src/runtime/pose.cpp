@@ -36,7 +36,8 @@ KEYANIM_INLINE inline QuatLanes<V> rotate_by(const QuatLanes<V>& q, uint32_t axi
   }
 }
 
-// The angles of `lanes` nodes (the rest 0) from their columns, gathered into registers.
+// The angles of `lanes` nodes (the rest 0) from their columns, gathered into registers (the
+// first parameter only picks the register type: F4 or F8).
 KEYANIM_INLINE inline F4 gather_angles(const F4*, const float* values, const uint32_t* column, uint32_t column0,
                                        uint32_t lanes) noexcept {
   auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
