@@ -54,10 +54,14 @@
 // Internal, for one purpose: the cold figure flushes every array a loaded clip owns, which only
 // the runtime's image layout lists (bench_decode does the same). Nothing else reads it.
 #include "cold.h"
+#include "corpus_groups.h"
 
 namespace {
 
+using bench::CorpusClip;
+using bench::CorpusError;
 using bench::cpu_ns;
+using bench::find_clips;
 using bench::fence;
 using bench::flush;
 using bench::flush_image;
@@ -86,42 +90,6 @@ void sink(float v) { g_sink = g_sink + v; }
 
 // ---------------------------------------------------------------------------------------------
 // The clips
-
-struct CorpusClip {
-  fs::path path;
-  std::string name;   // file name
-  std::string group;  // "cmu120" or "bandai30"
-  Motion motion;
-  double rate = 0;    // frames per second, snapped to an integer within 0.05% (ACL's sample rate)
-};
-
-// 1 / frame_time, snapped to the nearest integer when within 0.05% of it (120.005 -> 120).
-double sample_rate(double frame_time) {
-  const double r = 1.0 / frame_time, n = std::round(r);
-  return std::abs(r - n) <= 0.0005 * n ? n : r;
-}
-
-// The clips of cmu/ at 120 fps and bandai/ at 30 fps whose name contains `filter`, in name order.
-std::vector<CorpusClip> find_clips(const fs::path& corpus, const std::string& filter) {
-  std::vector<CorpusClip> out;
-  for (const auto& [dir, group, fps] : {std::tuple{"cmu", "cmu120", 120.0}, {"bandai", "bandai30", 30.0}}) {
-    std::vector<fs::path> files;
-    std::error_code ec;
-    if (!fs::is_directory(corpus / dir)) continue;  // a corpus without this group
-    for (const auto& e : fs::directory_iterator(corpus / dir, ec))
-      if (e.path().extension() == ".bvh" && e.path().filename().string().find(filter) != std::string::npos)
-        files.push_back(e.path());
-    if (ec) throw BenchError(corpus.string() + "/" + dir + ": " + ec.message());
-    std::sort(files.begin(), files.end());
-    for (const fs::path& p : files) {
-      CorpusClip c{p, p.filename().string(), group, ko::read_bvh_file(p.string()), 0};
-      if (c.motion.frame_count < 2 || c.motion.frame_time <= 0) continue;
-      c.rate = sample_rate(c.motion.frame_time);
-      if (c.rate == fps) out.push_back(std::move(c));
-    }
-  }
-  return out;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Poses in double precision, for the error: one FK for the original and both decodes.
@@ -862,6 +830,9 @@ int main(int argc, char** argv) {
     std::cerr << "bench_vs_acl: " << e.what() << "\n";
     return 1;
   } catch (const ko::Error& e) {
+    std::cerr << "bench_vs_acl: " << e.what() << "\n";
+    return 1;
+  } catch (const CorpusError& e) {
     std::cerr << "bench_vs_acl: " << e.what() << "\n";
     return 1;
   }

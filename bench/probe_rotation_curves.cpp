@@ -55,10 +55,13 @@
 #include "offline/encode/channel_fit.h"
 #include "offline/encode/signals.h"
 #include "offline/parallel.h"
+#include "corpus_groups.h"
 
 namespace fs = std::filesystem;
 namespace ko = keyanim::offline;
 using nlohmann::json;
+using bench::CorpusClip;
+using bench::find_clips;
 
 namespace {
 
@@ -329,45 +332,6 @@ void encoder_reference(const ko::Motion& m, unsigned threads, double tol_units, 
 }
 
 // ---- A clip
-
-struct CorpusClip {
-  fs::path path;
-  std::string name, group;
-  ko::Motion motion;
-};
-
-// 1 / frame_time, snapped to the nearest integer when within 0.05% of it (bench_vs_acl's rule).
-double sample_rate(double frame_time) {
-  const double r = 1.0 / frame_time, n = std::round(r);
-  return std::abs(r - n) <= 0.0005 * n ? n : r;
-}
-
-// bench_vs_acl's selection: cmu/ at 120 fps, bandai/ at 30 fps, names containing `filter`,
-// in name order. A file that does not load stops the probe, naming it.
-std::vector<CorpusClip> find_clips(const fs::path& corpus, const std::string& filter) {
-  std::vector<CorpusClip> out;
-  for (const auto& [dir, group, fps] : {std::tuple{"cmu", "cmu120", 120.0}, {"bandai", "bandai30", 30.0}}) {
-    std::vector<fs::path> files;
-    std::error_code ec;
-    if (!fs::is_directory(corpus / dir)) continue;
-    for (const auto& e : fs::directory_iterator(corpus / dir, ec))
-      if (e.path().extension() == ".bvh" && e.path().filename().string().find(filter) != std::string::npos)
-        files.push_back(e.path());
-    if (ec) throw ProbeError(corpus.string() + "/" + dir + ": " + ec.message());
-    std::sort(files.begin(), files.end());
-    for (const fs::path& p : files) {
-      CorpusClip c{p, p.filename().string(), group, {}};
-      try {
-        c.motion = ko::read_bvh_file(p.string());
-      } catch (const std::exception& e) {
-        throw ProbeError(p.string() + ": cannot load: " + e.what());
-      }
-      if (c.motion.frame_count < 2 || c.motion.frame_time <= 0) continue;
-      if (sample_rate(c.motion.frame_time) == fps) out.push_back(std::move(c));
-    }
-  }
-  return out;
-}
 
 json joint_json(const keyanim::Skeleton& s, const JointProbe& p) {
   constexpr double deg = 180.0 / std::numbers::pi;
