@@ -37,6 +37,8 @@ struct F8 {
     std::memcpy(&r.v, p, sizeof r.v);
     return r;
   }
+  // Lanes 0-3 from lo, 4-7 from hi.
+  KEYANIM_INLINE static F8 join(F4 lo, F4 hi) { return F8(__builtin_shufflevector(lo.v, hi.v, 0, 1, 2, 3, 4, 5, 6, 7)); }
   KEYANIM_INLINE void store(float* p) const { std::memcpy(p, &v, sizeof v); }
   KEYANIM_INLINE F4 low() const { return F4(__builtin_shufflevector(v, v, 0, 1, 2, 3)); }
   KEYANIM_INLINE F4 high() const { return F4(__builtin_shufflevector(v, v, 4, 5, 6, 7)); }
@@ -45,10 +47,8 @@ struct F8 {
 struct I8 {
   V8i v;
   KEYANIM_INLINE static I8 splat(int32_t x) { return I8{V8i{x, x, x, x, x, x, x, x}}; }
-  KEYANIM_INLINE static I8 load(const int32_t* p) {
-    I8 r;
-    std::memcpy(&r.v, p, sizeof r.v);
-    return r;
+  KEYANIM_INLINE static I8 join(I4 lo, I4 hi) {
+    return I8{__builtin_shufflevector(V4i(lo.v), V4i(hi.v), 0, 1, 2, 3, 4, 5, 6, 7)};
   }
 };
 

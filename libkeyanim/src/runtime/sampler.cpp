@@ -13,7 +13,6 @@
 #include "internal/cpu.h"
 #include "internal/simd.h"
 #include "internal/simd8.h"
-#include "runtime/records_v3.h"
 
 namespace keyanim::internal {
 namespace {
@@ -23,12 +22,11 @@ constexpr uint32_t kPrefetchAhead = 6;  // curves
 static_assert(kPrefetchAhead <= kPrefetchRecords, "the offsets ahead are read unchecked");
 
 // Pass one's output for a chunk: per lane its keys j-1 .. j+2 (frames relative to the block,
-// dequantized values), key by key (frames[r][lane]: key j-1+r) so that pass two loads them as
-// vectors, and the per-curve facts the evaluation needs (which the sampler of all curves reads
-// straight from the image instead).
+// dequantized values), and the per-curve facts the evaluation needs (which the sampler of all
+// curves reads straight from the image instead).
 struct Batch {
-  alignas(32) int32_t frames[4][kChunk];
-  alignas(32) float values[4][kChunk];
+  alignas(16) int32_t frames[kChunk][4];
+  alignas(16) float values[kChunk][4];
   float s[kChunk], first_frame[kChunk], last_frame[kChunk], first_value[kChunk], last_value[kChunk];
   uint32_t linear[kChunk];
 };
@@ -120,27 +118,9 @@ template <bool kPopcnt>
   const uint8_t* rec = v.payload + v.offsets[curve];
   Window w;
   read_window<kPopcnt>(rec, cv.base_bits, v.upto, w);
-  float value[4];
-  dequantize4(rec, w, cv, value);
-  for (int r = 0; r < 4; ++r) b.frames[r][i] = w.frame[r], b.values[r][i] = value[r];
+  std::memcpy(b.frames[i], w.frame, sizeof w.frame);
+  dequantize4(rec, w, cv, b.values[i]);
 }
-
-#if KEYANIM_RECORDS_V3
-// The v3 level's first pass over the block curves base .. base + count - 1 (lanes 0 .. count - 1):
-// four records at a time (runtime/records_v3.h), prefetched as sample_curves does, the four
-// scalar where that path does not apply. Returns the lanes done (a multiple of 4); the caller
-// reads the rest. Out of line, and one call per chunk: the vector code must not inline into
-// code compiled for another level.
-KEYANIM_V3_TARGET uint32_t gather_fours_v3(const BlockView& v, uint32_t base, uint32_t count, Batch& b) noexcept {
-  uint32_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    for (uint32_t r = 0; r < 4; ++r) __builtin_prefetch(v.payload + v.offsets[base + i + r + kPrefetchAhead]);
-    if (!v3::read_windows4(v.payload, v.offsets, v.curves, base + i, v.upto, &b.frames[0][i], &b.values[0][i], kChunk))
-      for (uint32_t r = 0; r < 4; ++r) gather<true>(v, base + i + r, b, i + r);
-  }
-  return i;
-}
-#endif
 
 // A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
 // first or last segment outside the keys), with virtual keys beyond the ends as in records.
@@ -171,11 +151,14 @@ void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b,
   ListWindow w;
   list_window(img, img.lists[curve - img.block_curves], at.f, w);
   const int64_t start = int64_t(at.block) << kBlockShift;  // frames relative to f's block, as records
-  for (int k = 0; k < 4; ++k) b.frames[k][i] = static_cast<int32_t>(w.frame[k] - start), b.values[k][i] = w.value[k];
+  for (int k = 0; k < 4; ++k) b.frames[i][k] = static_cast<int32_t>(w.frame[k] - start);
+  std::memcpy(b.values[i], w.value, sizeof w.value);
 }
 
 void set_fixed(Batch& b, uint32_t i, float v) noexcept {
-  for (int k = 0; k < 4; ++k) b.frames[k][i] = k < 2 ? 0 : 1, b.values[k][i] = 0.0f;
+  std::memset(b.frames[i], 0, sizeof b.frames[i]);
+  b.frames[i][2] = b.frames[i][3] = 1;
+  std::memset(b.values[i], 0, sizeof b.values[i]);
   b.s[i] = 0.0f;
   b.first_frame[i] = std::numeric_limits<float>::infinity();  // every position is "before"
   b.last_frame[i] = std::numeric_limits<float>::infinity();
@@ -192,13 +175,19 @@ void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept
   b.linear[i] = img.curve_linear[curve];
 }
 
-// Pass two's loads of one group of lanes from i: k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2}.
+// Pass two's loads of one group of lanes from i: the frames and values of each lane's four
+// keys, transposed into k_{j-1} .. k_{j+2} and p_{j-1} .. p_{j+2} vectors.
 KEYANIM_INLINE inline void load_keys(const Batch& b, uint32_t i, I4 (&k)[4], F4 (&p)[4]) noexcept {
-  for (int r = 0; r < 4; ++r) k[r] = I4::load(b.frames[r] + i), p[r] = F4::load(b.values[r] + i);
+  for (int r = 0; r < 4; ++r) k[r] = I4::load(b.frames[i + r]), p[r] = F4::load(b.values[i + r]);
+  transpose(k[0], k[1], k[2], k[3]);
+  transpose(p[0], p[1], p[2], p[3]);
 }
 #if KEYANIM_WIDE_LANES
 KEYANIM_INLINE inline void load_keys(const Batch& b, uint32_t i, I8 (&k)[4], F8 (&p)[4]) noexcept {
-  for (int r = 0; r < 4; ++r) k[r] = I8::load(b.frames[r] + i), p[r] = F8::load(b.values[r] + i);
+  I4 klo[4], khi[4];
+  F4 plo[4], phi[4];
+  load_keys(b, i, klo, plo), load_keys(b, i + 4, khi, phi);
+  for (int r = 0; r < 4; ++r) k[r] = I8::join(klo[r], khi[r]), p[r] = F8::join(plo[r], phi[r]);
 }
 #endif
 template <class V> struct IntLanes;
@@ -310,18 +299,14 @@ template <bool kPopcnt, bool kWide>
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
     const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
-    uint32_t i = 0;
-#if KEYANIM_RECORDS_V3
-    if constexpr (kWide) i = gather_fours_v3(view, base, blocked, b);
-#endif
-    for (; i < blocked; ++i) {
+    for (uint32_t i = 0; i < blocked; ++i) {
       // The record a few curves ahead: its address needs a load first, so a cold clip's misses
       // overlap only if they are asked for early. Past the block's last curve this reads the
       // next block's offsets or the padding (Image::record_offset): a harmless prefetch.
       __builtin_prefetch(view.payload + view.offsets[base + i + kPrefetchAhead]);
       gather<kPopcnt>(view, base + i, b, i);
     }
-    for (i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
+    for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
   };
   auto facts = [&](const Batch&, uint32_t base) KEYANIM_INLINE {
     return Facts{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
