@@ -207,6 +207,34 @@ TEST_SUITE("verify") {
       CHECK(o.frame <= 12);
     }
     CHECK(only.size() >= 3);  // with a tolerance of 0, whatever moved is over
+    // A later round measures only the nodes that were over and the subtrees that moved, and
+    // finds exactly what verifying every node finds: edit the Arm's keys, mark what changed,
+    // verify again with the marks of the first pass, and compare with a fresh full pass.
+    std::vector<EncodedChannel> edited = clip.channels;
+    edited[2].q[4] += 40;  // the Arm's z rotation, at one key: frames 74 to 222 change
+    std::vector<std::pair<uint32_t, uint32_t>> ranges;
+    changed_ranges(clip.channels[2], edited[2], 300, ranges);
+    CHECK(!ranges.empty());
+    for (const auto& [a, b] : ranges) marks.mark(1, a, b);
+    std::vector<OverNode> incremental, full;
+    for (uint32_t first = 0; first < 300; first += 64)
+      verify_window(m, edited, clip.tangent_rule, tol, shell, first, std::min(64u, 300 - first), marks, incremental,
+                    scratch);
+    FrameMarks fresh(300, 3);
+    fresh.mark_all();
+    for (uint32_t first = 0; first < 300; first += 64)
+      verify_window(m, edited, clip.tangent_rule, tol, shell, first, std::min(64u, 300 - first), fresh, full, scratch);
+    size_t outside = 0;  // over entries the edit cannot have caused: measured as over nodes only
+    for (const OverNode& o : full) outside += o.frame < ranges.front().first || o.frame > ranges.back().second;
+    CHECK(outside > 0);
+    REQUIRE(incremental.size() == full.size());
+    for (size_t i = 0; i < full.size(); ++i) {
+      CHECK(incremental[i].frame == full[i].frame);
+      CHECK(uint32_t(incremental[i].node) == uint32_t(full[i].node));
+      CHECK(uint32_t(incremental[i].shell) == uint32_t(full[i].shell));
+      CHECK(incremental[i].error == full[i].error);
+    }
+    for (uint32_t f = 0; f < 300; ++f) CHECK(marks.check()[f] == fresh.check()[f]);
     }
   }
 

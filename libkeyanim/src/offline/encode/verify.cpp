@@ -76,7 +76,7 @@ void changed_ranges(const EncodedChannel& a, const EncodedChannel& b, uint32_t f
 }
 
 FrameMarks::FrameMarks(uint32_t frames, size_t nodes)
-    : words_((size_t(frames) + 63) / 64), check_(frames, 0), moved_(nodes * words_, 0) {}
+    : words_((size_t(frames) + 63) / 64), check_(frames, 0), moved_(nodes * words_, 0), over_(nodes * words_, 0) {}
 
 void FrameMarks::mark(uint32_t node, uint32_t first, uint32_t last) {
   for (uint32_t f = first; f <= last; ++f) check_[f] |= kChanged;
@@ -96,14 +96,17 @@ void FrameMarks::clear_moved() { std::fill(moved_.begin(), moved_.end(), 0); }
 
 namespace {
 
-// Marks in w.measure[k] the nodes to measure at frame f: all, or the subtrees of the nodes that
-// moved; adds them to w.pose.
+// Marks in w.measure[k] the nodes to measure at frame f (nonzero): all of them (kAll), or the
+// nodes that were over and the subtrees of the nodes that moved (kSubtree: a node's value
+// depends on its ancestors'); adds them to w.pose.
+constexpr uint8_t kMeasure = 1, kSubtree = 2;
 void select_nodes(const Skeleton& s, const FrameMarks& marks, uint8_t check, uint32_t f, size_t k, VerifyScratch& w) {
-  const bool all = check & FrameMarks::kOver;
+  const bool all = check & FrameMarks::kAll, any_over = check & FrameMarks::kOver;
   uint8_t* measure = w.measure[k].data();
   for (size_t j = 0; j < s.joints.size(); ++j) {
     const int32_t p = s.joints[j].parent;
-    measure[j] = all || marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && measure[size_t(p)]);
+    const bool subtree = marks.moved(uint32_t(j), f) || (p >= 0 && size_t(p) < j && (measure[size_t(p)] & kSubtree));
+    measure[j] = subtree ? kSubtree | kMeasure : all || (any_over && marks.over(uint32_t(j), f)) ? kMeasure : 0;
     w.pose[j] |= measure[j];
     w.error[k][j] = 0.0, w.shell_over[k][j] = 0;
   }
@@ -184,7 +187,9 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
       const uint32_t f = w.frames[i + k];
       bool frame_over = false;
       for (size_t d = 0; d < nodes; ++d) {
-        if (!w.measure[k][d] || w.error[k][d] <= tol) continue;
+        if (!w.measure[k][d]) continue;
+        marks.set_over(uint32_t(d), f, w.error[k][d] > tol);
+        if (w.error[k][d] <= tol) continue;
         over.push_back({f, uint32_t(d) & 0x7FFFFFFFu, w.shell_over[k][d] != 0u, w.error[k][d]});  // nodes < 2^31
         frame_over = true;
       }

@@ -67,26 +67,37 @@ struct OverNode {
 };
 static_assert(sizeof(OverNode) == 16);
 
-// What to verify, frame by frame, and which nodes may have moved there.
+// What to verify, frame by frame, and which nodes may have moved or were over there.
 class FrameMarks {
  public:
   static constexpr uint8_t kChanged = 1;  // some decoded value may have changed
-  static constexpr uint8_t kOver = 2;     // over the tolerance when last verified: verify every node
+  static constexpr uint8_t kOver = 2;     // some node was over the tolerance when last verified
+  static constexpr uint8_t kAll = 4;      // verify every node (every frame, in the first round)
 
   FrameMarks(uint32_t frames, size_t nodes);
-  // Frame f is to be verified in full (every frame, in the first round).
-  void mark_all() { std::fill(check_.begin(), check_.end(), kOver); }
+  void mark_all() { std::fill(check_.begin(), check_.end(), kAll); }
   // Channels of `node` may decode differently at frames [first, last].
   void mark(uint32_t node, uint32_t first, uint32_t last);
   // Forgets which nodes moved (after a round's verification).
   void clear_moved();
   uint8_t* check() { return check_.data(); }
-  bool moved(uint32_t node, uint32_t f) const { return moved_[node * words_ + f / 64] >> (f % 64) & 1; }
+  bool moved(uint32_t node, uint32_t f) const { return bit(moved_, node, f); }
+  bool over(uint32_t node, uint32_t f) const { return bit(over_, node, f); }
+  // Records whether `node` was over at f. Calls for frames in different 64-frame words may run
+  // concurrently.
+  void set_over(uint32_t node, uint32_t f, bool over) {
+    uint64_t& w = over_[node * words_ + f / 64];
+    w = over ? w | uint64_t(1) << (f % 64) : w & ~(uint64_t(1) << (f % 64));
+  }
 
  private:
+  bool bit(const std::vector<uint64_t>& bits, uint32_t node, uint32_t f) const {
+    return bits[node * words_ + f / 64] >> (f % 64) & 1;
+  }
   size_t words_;
   std::vector<uint8_t> check_;   // per frame
   std::vector<uint64_t> moved_;  // per node, a bit per frame
+  std::vector<uint64_t> over_;   // per node, a bit per frame: over when last measured
 };
 
 // Working memory of verify_window, one per thread. Frames are verified two at a time (four
@@ -106,9 +117,11 @@ struct VerifyScratch {
 // the nodes that moved there (and their ancestors), poses original and decoded (under each of
 // measured_readings), and appends to `over` each node whose error on its measured points
 // (shell distance `shell`) exceeds `tolerance` (frame order, then node order) with its error,
-// computed as measure_error does. A frame marked only kChanged measures only the
-// subtrees of the nodes that moved: the others have not moved since they were last found
-// within the tolerance. Frames with a node over stay marked kOver; the others are unmarked.
+// computed as measure_error does. Only the nodes that can have changed are measured: the
+// subtrees of the nodes that moved, and the nodes that were over (every node at a frame marked
+// kAll); every other node has not moved since it was last found within the tolerance, so the
+// list is the one measuring every node would give. Frames with a node over stay marked kOver;
+// the others are unmarked. `first` is a multiple of 64 where windows run concurrently.
 void verify_window(const Motion& original, const std::vector<EncodedChannel>& channels, TangentRule rule,
                    double tolerance, double shell, uint32_t first, uint32_t count, FrameMarks& marks,
                    std::vector<OverNode>& over, VerifyScratch& scratch);
