@@ -698,3 +698,49 @@ TEST_CASE("metrics: mismatched or broken motions are errors and NaN values an in
 }
 
 }  // TEST_SUITE
+
+TEST_CASE("metrics: an accumulator fed two frames at a time reports what one frame at a time does") {
+  // add_frames is two add_frame calls to the bit, including which of equal errors is the worst
+  // (the first): the position-channel motion below has equal errors on all four frames and both
+  // readings; the CMU take's decoding is perturbed by a pseudo-random amount on every channel.
+  auto same = [](const keyanim::offline::ErrorReport& a, const keyanim::offline::ErrorReport& b) {
+    CHECK(a.max_error == b.max_error);
+    CHECK(a.rms_error == b.rms_error);
+    CHECK(a.worst_joint == b.worst_joint);
+    CHECK(a.worst_point == b.worst_point);
+    CHECK(a.worst_frame == b.worst_frame);
+    CHECK(a.worst_reading == b.worst_reading);
+    CHECK(a.reading_max == b.reading_max);
+    CHECK(a.joint_max == b.joint_max);
+    CHECK(a.channel_max == b.channel_max);
+  };
+  Motion ties;
+  ties.skeleton = skeleton_of({joint("Hips", -1, {0, 0, 0}, {kZr}), joint("Arm", 0, {0, 5, 0}, {kXp, kYp, kZp, kZr}),
+                               end_site(1, {3, 0, 0})});
+  ties.frame_count = 4;
+  ties.values.assign(4 * 5, 0.0);
+  Motion ties_decoded = ties;
+  for (uint32_t f = 0; f < 4; ++f) ties_decoded.values[f * 5] = 2.0;
+  Motion clip = keyanim::offline::read_bvh_file(KEYANIM_REPO_DATA_DIR "/cmu_131_03_hop.bvh");
+  Motion clip_decoded = clip;
+  uint32_t state = 12345;
+  for (double& v : clip_decoded.values) {
+    state = state * 1664525u + 1013904223u;
+    v += double(state >> 8) / double(1u << 24) * 0.2 - 0.1;
+  }
+  for (const auto& [original, decoded] : {std::pair{&ties, &ties_decoded}, std::pair{&clip, &clip_decoded}}) {
+    const size_t n_ch = original->values.size() / original->frame_count;
+    const double shell = keyanim::offline::default_shell(*original);
+    keyanim::offline::ErrorAccumulator one(original->skeleton, shell), two(original->skeleton, shell);
+    auto row = [&](const Motion* m, uint32_t f) { return m->values.data() + f * n_ch; };
+    for (uint32_t f = 0; f < original->frame_count; ++f) one.add_frame(f, row(original, f), row(decoded, f));
+    uint32_t f = 0;
+    for (; f + 1 < original->frame_count; f += 2)
+      two.add_frames(f, {row(original, f), row(decoded, f), row(original, f + 1), row(decoded, f + 1)});
+    if (f < original->frame_count) two.add_frame(f, row(original, f), row(decoded, f));
+    const auto a = one.report(original->frame_count), b = two.report(original->frame_count);
+    CHECK(a.max_error > 0.0);
+    CHECK(a.both_readings == (original == &ties));
+    same(a, b);
+  }
+}

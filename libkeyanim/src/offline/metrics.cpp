@@ -114,35 +114,59 @@ ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, double shell, const
       node_max_(skeleton.joints.size(), 0.0) {}
 
 void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const double* decoded) {
-  const size_t nodes = joint_max_.size();
-  const std::span<const PositionReading> readings = measured_readings(*skeleton_);
-  for (size_t j = 0; j < nodes; ++j) node_max_[j] = 0.0;
-  for (const PositionReading reading : readings) {
+  std::fill(node_max_.begin(), node_max_.end(), 0.0);
+  for (const PositionReading reading : measured_readings(*skeleton_)) {
     if (decoded_skeleton_ == skeleton_) {
       measured_points(*skeleton_, original, decoded, shell_, reading, a_, b_);
     } else {
       measured_points(*skeleton_, original, shell_, reading, a_);
       measured_points(*decoded_skeleton_, decoded, shell_, reading, b_);
     }
-    for (size_t j = 0; j < nodes; ++j) {
-      const size_t first = j * kPointsPerNode;
-      for (size_t p = first; p < first + measured_point_count(skeleton_->joints[j], shell_); ++p) {
-        const double dx = a_[p][0] - b_[p][0];
-        const double dy = a_[p][1] - b_[p][1];
-        const double dz = a_[p][2] - b_[p][2];
-        const double e = sanitize(std::sqrt(dx * dx + dy * dy + dz * dz));
-        node_max_[j] = std::max(node_max_[j], e);
-        double& by_reading = reading_max_[size_t(reading)];
-        by_reading = std::max(by_reading, e);
-        if (!any_ || e > max_error_) {
-          max_error_ = e, worst_joint_ = uint32_t(j), worst_point_ = uint32_t(p - first), worst_frame_ = frame;
-          worst_reading_ = reading;
-          any_ = true;
-        }
+    add_points(frame, reading, a_, b_);
+  }
+  end_frame(original, decoded);
+}
+
+void ErrorAccumulator::add_frames(uint32_t frame, const std::array<const double*, 4>& rows) {
+  if (decoded_skeleton_ != skeleton_) {
+    add_frame(frame, rows[0], rows[1]);
+    return add_frame(frame + 1, rows[2], rows[3]);
+  }
+  // Both frames' points under every reading first, then each frame as add_frame takes it:
+  // the same comparisons in the same order (the first of equal errors stays the worst).
+  const std::span<const PositionReading> readings = measured_readings(*skeleton_);
+  for (size_t r = 0; r < readings.size(); ++r) measured_points(*skeleton_, rows, shell_, readings[r], quad_[r]);
+  for (size_t k = 0; k < 2; ++k) {
+    std::fill(node_max_.begin(), node_max_.end(), 0.0);
+    for (size_t r = 0; r < readings.size(); ++r)
+      add_points(frame + uint32_t(k), readings[r], quad_[r][2 * k], quad_[r][2 * k + 1]);
+    end_frame(rows[2 * k], rows[2 * k + 1]);
+  }
+}
+
+void ErrorAccumulator::add_points(uint32_t frame, PositionReading reading, const std::vector<Vec3>& a,
+                                  const std::vector<Vec3>& b) {
+  for (size_t j = 0; j < node_max_.size(); ++j) {
+    const size_t first = j * kPointsPerNode;
+    for (size_t p = first; p < first + measured_point_count(skeleton_->joints[j], shell_); ++p) {
+      const double dx = a[p][0] - b[p][0];
+      const double dy = a[p][1] - b[p][1];
+      const double dz = a[p][2] - b[p][2];
+      const double e = sanitize(std::sqrt(dx * dx + dy * dy + dz * dz));
+      node_max_[j] = std::max(node_max_[j], e);
+      double& by_reading = reading_max_[size_t(reading)];
+      by_reading = std::max(by_reading, e);
+      if (!any_ || e > max_error_) {
+        max_error_ = e, worst_joint_ = uint32_t(j), worst_point_ = uint32_t(p - first), worst_frame_ = frame;
+        worst_reading_ = reading;
+        any_ = true;
       }
     }
   }
-  for (size_t j = 0; j < nodes; ++j) {
+}
+
+void ErrorAccumulator::end_frame(const double* original, const double* decoded) {
+  for (size_t j = 0; j < node_max_.size(); ++j) {
     sum_sq_ += node_max_[j] * node_max_[j];
     joint_max_[j] = std::max(joint_max_[j], node_max_[j]);
   }
@@ -209,8 +233,11 @@ ErrorReport measure_error(const Motion& original, const Motion& decoded, double 
   const uint32_t window = measure_window(measured);
   for (uint32_t first = 0; first < measured; first += window) {
     ErrorAccumulator part(original.skeleton, shell, &decoded.skeleton);
-    for (uint32_t f = first; f < std::min(measured, first + window); ++f)
-      part.add_frame(f, original.values.data() + size_t(f) * channels, decoded.values.data() + size_t(f) * channels);
+    const uint32_t end = std::min(measured, first + window);
+    auto row = [&](const Motion& m, uint32_t f) { return m.values.data() + size_t(f) * channels; };
+    uint32_t f = first;
+    for (; f + 1 < end; f += 2) part.add_frames(f, {row(original, f), row(decoded, f), row(original, f + 1), row(decoded, f + 1)});
+    if (f < end) part.add_frame(f, row(original, f), row(decoded, f));
     total.merge(part);
   }
   return total.report(measured);

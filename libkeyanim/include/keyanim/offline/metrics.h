@@ -85,6 +85,9 @@ class ErrorAccumulator {
   ErrorAccumulator(const Skeleton& original, double shell, const Skeleton* decoded = nullptr);
   // Frame `frame`: a frame row of the original and of the decoded motion.
   void add_frame(uint32_t frame, const double* original_row, const double* decoded_row);
+  // Frames `frame` and `frame + 1` (rows: original, decoded, original, decoded): two add_frame
+  // calls to the bit, posed four rows at once.
+  void add_frames(uint32_t frame, const std::array<const double*, 4>& rows);
   // Appends the frames of `later`, which all come after this one's.
   void merge(const ErrorAccumulator& later);
   // The report over `frames` frames (the rms divides by frames x nodes).
@@ -103,6 +106,10 @@ class ErrorAccumulator {
   std::vector<double> joint_max_, channel_max_;
   std::vector<double> node_max_;  // scratch of add_frame: this frame's, per node
   std::vector<std::array<double, 3>> a_, b_;
+  std::array<std::array<std::vector<std::array<double, 3>>, 4>, 2> quad_;  // add_frames: per reading
+  void add_points(uint32_t frame, PositionReading reading, const std::vector<std::array<double, 3>>& original,
+                  const std::vector<std::array<double, 3>>& decoded);
+  void end_frame(const double* original_row, const double* decoded_row);
 };
 uint32_t measure_window(uint32_t frame_count);
 

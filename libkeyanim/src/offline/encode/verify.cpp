@@ -209,13 +209,20 @@ ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, double shel
     Cursor cursor;
     if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
     std::vector<float> row(n_ch);
-    std::vector<double> decoded(n_ch);
-    const uint32_t end = uint32_t(std::min<size_t>(frames, (w + 1) * window));
-    for (uint32_t f = uint32_t(w * window); f < end; ++f) {
+    std::array<std::vector<double>, 2> decoded{std::vector<double>(n_ch), std::vector<double>(n_ch)};
+    auto decode = [&](uint32_t f, std::vector<double>& out) {
       clip.sample(double(f), row, &cursor);
-      std::copy(row.begin(), row.end(), decoded.begin());
-      parts[w].add_frame(f, m.values.data() + size_t(f) * n_ch, decoded.data());
+      std::copy(row.begin(), row.end(), out.begin());
+      return out.data();
+    };
+    auto original = [&](uint32_t f) { return m.values.data() + size_t(f) * n_ch; };
+    const uint32_t end = uint32_t(std::min<size_t>(frames, (w + 1) * window));
+    uint32_t f = uint32_t(w * window);
+    for (; f + 1 < end; f += 2) {  // two frames at a time: one FK poses four rows
+      const double* a = decode(f, decoded[0]);
+      parts[w].add_frames(f, {original(f), a, original(f + 1), decode(f + 1, decoded[1])});
     }
+    if (f < end) parts[w].add_frame(f, original(f), decode(f, decoded[0]));
   });
   ErrorAccumulator total(m.skeleton, shell);
   for (const ErrorAccumulator& p : parts) total.merge(p);
