@@ -59,8 +59,17 @@ void changed_ranges(const EncodedChannel& a, const EncodedChannel& b, uint32_t f
     else out.push_back({lo, hi});
     marked = hi + 1;
   };
-  size_t i = 0, j = 0;  // merge both key lists by frame
-  while (i < na || j < nb) {
+  // Keys both lists share at the start and at the end (the same frame and value) change
+  // nothing; only the keys between them are merged. A refit usually moves a few keys.
+  size_t same_front = 0, same_back = 0;
+  if (a.step == b.step) {
+    const size_t common = std::min(na, nb);
+    auto same = [&](size_t ka, size_t kb) { return a.frames[ka] == b.frames[kb] && a.q[ka] == b.q[kb]; };
+    while (same_front < common && same(same_front, same_front)) ++same_front;
+    while (same_front + same_back < common && same(na - 1 - same_back, nb - 1 - same_back)) ++same_back;
+  }
+  size_t i = same_front, j = same_front;  // merge the rest of both key lists by frame
+  while (i < na - same_back || j < nb - same_back) {
     const uint32_t fa = i < na ? a.frames[i] : UINT32_MAX, fb = j < nb ? b.frames[j] : UINT32_MAX;
     const uint32_t g = std::min(fa, fb);
     const bool in_a = fa == g, in_b = fb == g;
