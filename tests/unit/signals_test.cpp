@@ -56,6 +56,12 @@ TEST_SUITE("signals") {
     m.skeleton.joints[1].offset = {9e36, 0, 0};
     m.values[299 * 2] = 9e36;
     for (unsigned threads : {1u, 2u}) CHECK(refusal(m, threads).find("overflow") != std::string::npos);
+    // Reaches that could add up beyond it but do not at any frame: accepted (FK says so, not the bound).
+    m.values[299 * 2] = 0.0;
+    m.values[5 * 2] = -9e36;
+    for (unsigned threads : {1u, 2u}) CHECK(refusal(m, threads).empty());
+    m.values[5 * 2 + 1] = 180.0;  // the same translation, turned to point the End Site back: 1.8e37 away
+    for (unsigned threads : {1u, 2u}) CHECK(refusal(m, threads).find("overflow") != std::string::npos);
   }
 
   TEST_CASE("channel layout and signals: a column, unwrapped when it is an angle") {

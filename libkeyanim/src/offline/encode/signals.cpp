@@ -33,6 +33,26 @@ Error bad_value(const Motion& m, size_t i) {
   return Error(ErrorKind::malformed, name + " of frame " + std::to_string(f) + " " + what);
 }
 
+// No world position of any frame is farther from the origin than this: rotations keep lengths,
+// so a node is at most the sum, over it and its ancestors, of |OFFSET| and the longest
+// translation its position channels can make (each at its largest magnitude `largest`, either
+// reading). Rounding in FK adds a few ulps per level, far inside the halved limit it is held to.
+double reach_bound(const Skeleton& s, const std::vector<double>& largest) {
+  std::vector<double> reach(s.joints.size(), 0.0);
+  double most = 0.0;
+  for (size_t j = 0; j < s.joints.size(); ++j) {
+    const Joint& joint = s.joints[j];
+    double t = 0.0;
+    for (size_t k = 0; k < joint.channels.size(); ++k)
+      if (!is_rotation(joint.channels[k])) t += largest[joint.first_channel + k] * largest[joint.first_channel + k];
+    const Vec3& o = joint.offset;
+    reach[j] = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]) + std::sqrt(t);
+    if (joint.parent >= 0 && size_t(joint.parent) < j) reach[j] += reach[size_t(joint.parent)];
+    most = std::max(most, reach[j]);
+  }
+  return most;
+}
+
 }  // namespace
 
 void check_motion(const Motion& m, unsigned threads) {
@@ -40,8 +60,14 @@ void check_motion(const Motion& m, unsigned threads) {
   if (m.values.size() != size_t(n_ch) * m.frame_count)
     throw Error(ErrorKind::invalid_argument,
                 "motion has " + std::to_string(m.values.size()) + " values, expected frames x channels");
-  for (size_t i = 0; i < m.values.size(); ++i)
-    if (!(std::fabs(m.values[i]) <= kMaxMagnitude)) throw bad_value(m, i);
+  std::vector<double> largest(n_ch, 0.0);  // per channel, of |value|
+  for (size_t row = 0; row < m.values.size(); row += n_ch)
+    for (size_t c = 0; c < n_ch; ++c) {
+      const double v = std::fabs(m.values[row + c]);
+      if (!(v <= kMaxMagnitude)) throw bad_value(m, row + c);
+      largest[c] = std::max(largest[c], v);
+    }
+  if (reach_bound(m.skeleton, largest) <= kMaxMagnitude / 2) return;  // no frame can overflow
   const size_t windows = (size_t(m.frame_count) + kCheckWindow - 1) / kCheckWindow;
   std::vector<uint8_t> overflow(windows, 0);
   parallel_for(windows, threads, [&](size_t w, unsigned) {
