@@ -312,6 +312,58 @@ TEST_CASE("fk of two or four frames at once is bit for bit one frame at a time")
   CHECK(differ == 0);
 }
 
+TEST_CASE("fk of both readings in one pass is bit for bit a pass per reading") {
+  // A Bandai take (position channels on every joint) when the corpus is here, and always a
+  // chain with position channels below the root and angles that take the scalar sine path.
+  std::vector<Motion> motions;
+  for (const auto& path : keyanim::test::corpus_bvh_files())
+    if (path.filename().string().find("bow_feminine_001") != std::string::npos)
+      motions.push_back(keyanim::offline::read_bvh_file(path.string()));
+  Motion chain;
+  chain.skeleton = skeleton_of({joint("Hips", -1, {1, 2, 3}, {kXp, kYp, kZp, kZr, kXr, kYr}),
+                                joint("Arm", 0, {0, 4, 0}, {kXp, kZp, kZr, kXr, kYr}), end_site(1, {0, 0, 5}),
+                                joint("Leg", 0, {0.5, -3, 0.25}, {kYp, kXr, kZr})});
+  chain.frame_count = 3;
+  chain.values = {0.5, -1, 2, 30.25, -1e9, 720.5, 7, -3.5, 45, 135, -225, 0.125, 10, 20,
+                  -2, 0, 1e-3, 3e12, -17.5, 90, 1e5, -1e5, -45, -135, 1e-300, -0.0, 33, -33,
+                  0, 0.25, -0.25, -0.0, 44.999999999999, 45.000000000001, 9, 8, -90, 180, 359.5, 1, 2, 3};
+  motions.push_back(chain);
+  const auto replace = keyanim::PositionReading::replace, add = keyanim::PositionReading::add;
+  size_t compared = 0, differ = 0;
+  for (const Motion& m : motions) {
+    REQUIRE(keyanim::offline::has_position_channels_below_root(m.skeleton));
+    const size_t n = m.skeleton.joints.size();
+    std::vector<uint8_t> some(n, 0);
+    for (size_t j = 1; j < n; j += 3) some[j] = 1;  // every third node and its ancestors
+    for (size_t j = n; j-- > 0;)
+      if (some[j] && m.skeleton.joints[j].parent >= 0) some[size_t(m.skeleton.joints[j].parent)] = 1;
+    auto same = [&](const std::vector<Vec3>& got, const std::vector<Vec3>& want, const uint8_t* nodes) {
+      for (size_t j = 0; j < n; ++j)
+        if (!nodes || nodes[j]) differ += std::memcmp(&got[4 * j], &want[4 * j], 4 * sizeof(Vec3)) != 0;
+      ++compared;
+    };
+    std::array<std::vector<Vec3>, 4> four, four_add, one_pass, one_pass_add;
+    std::vector<Vec3> a, b, a_add, b_add;
+    for (uint32_t f = 0; f < m.frame_count; ++f) {
+      const uint32_t g = (f * 7 + 1) % m.frame_count, h = (f + 2) % m.frame_count;
+      const std::array<const double*, 4> rows{m.frame(f), m.frame(g), m.frame(h), m.frame(f)};
+      for (const uint8_t* nodes : {static_cast<const uint8_t*>(nullptr), static_cast<const uint8_t*>(some.data())}) {
+        keyanim::offline::measured_points(m.skeleton, rows, 1.5, replace, four, nodes);
+        keyanim::offline::measured_points(m.skeleton, rows, 1.5, add, four_add, nodes);
+        keyanim::offline::measured_points(m.skeleton, rows, 1.5, replace, one_pass, nodes, &one_pass_add);
+        for (size_t i = 0; i < 4; ++i) same(one_pass[i], four[i], nodes), same(one_pass_add[i], four_add[i], nodes);
+        // Two rows (SSE2 lanes on every machine).
+        keyanim::offline::measured_points(m.skeleton, m.frame(f), m.frame(g), 1.5, replace, a, b, nodes, &a_add, &b_add);
+        same(a, four[0], nodes), same(b, four[1], nodes), same(a_add, four_add[0], nodes), same(b_add, four_add[1], nodes);
+      }
+    }
+    // The add reading does differ from replace here (else the test could not tell them apart).
+    CHECK(std::memcmp(four[0].data(), four_add[0].data(), four[0].size() * sizeof(Vec3)) != 0);
+  }
+  CHECK(compared >= 6 * 10 * 3);
+  CHECK(differ == 0);
+}
+
 TEST_CASE("fk local rotation equals the product of literal elementary matrices") {
   const std::array<std::array<ChannelType, 3>, 6> orders{{{kXr, kYr, kZr},
                                                            {kXr, kZr, kYr},

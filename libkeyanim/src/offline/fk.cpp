@@ -216,20 +216,19 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const ui
 }
 
 void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b) {
+                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
+                  std::vector<Vec3>* add_a, std::vector<Vec3>* add_b) {
   thread_local std::vector<std::array<Lanes2, 9>> rotations;
-  thread_local std::vector<std::array<Lanes2, 3>> positions;
+  thread_local std::vector<std::array<Lanes2, 3>> positions, positions_add;
   const size_t n = skeleton.joints.size();
-  if (rotations.size() < n) rotations.resize(n), positions.resize(n);
+  const bool both = add_a && add_b;
+  if (rotations.size() < n) rotations.resize(n), positions.resize(n), positions_add.resize(n);
   out_a.resize(4 * n), out_b.resize(4 * n);
-  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading);
+  if (both) add_a->resize(4 * n), add_b->resize(4 * n);
+  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading,
+             both ? positions_add.data() : nullptr);
   const Lanes2 d(distance);
-  for (size_t j = 0; j < n; ++j) {
-    if (nodes && !nodes[j]) continue;
-    const std::array<Lanes2, 3>& p = positions[j];
-    const std::array<Lanes2, 9>& r = rotations[j];
-    Vec3* a = &out_a[4 * j];
-    Vec3* b = &out_b[4 * j];
+  auto points = [&](const std::array<Lanes2, 3>& p, const std::array<Lanes2, 9>& r, size_t j, Vec3* a, Vec3* b) {
     for (int c = 0; c < 3; ++c) p[c].split(a[0][c], b[0][c]);
     if (distance > 0.0 && !skeleton.joints[j].end_site) {
       for (int axis = 0; axis < 3; ++axis)
@@ -237,18 +236,30 @@ void world_points(const Skeleton& skeleton, const double* row_a, const double* r
     } else {
       a[1] = a[2] = a[3] = a[0], b[1] = b[2] = b[3] = b[0];
     }
+  };
+  for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
+    points(positions[j], rotations[j], j, &out_a[4 * j], &out_b[4 * j]);
+    if (both) points(positions_add[j], rotations[j], j, &(*add_a)[4 * j], &(*add_b)[4 * j]);
   }
 }
 
 void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
-                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out) {
+                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out,
+                  std::array<std::vector<Vec3>, 4>* out_add) {
   if (internal::cpu_level() == internal::CpuLevel::v3) {
     Vec3* points[4];
+    Vec3* points_add[4];
     for (size_t i = 0; i < 4; ++i) out[i].resize(4 * skeleton.joints.size()), points[i] = out[i].data();
-    if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points)) return;
+    if (out_add)
+      for (size_t i = 0; i < 4; ++i) (*out_add)[i].resize(4 * skeleton.joints.size()), points_add[i] = (*out_add)[i].data();
+    if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points, out_add ? points_add : nullptr)) return;
   }
-  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1]);
-  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3]);
+  std::array<std::vector<Vec3>, 4>* add = out_add;
+  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1], add ? &(*add)[0] : nullptr,
+               add ? &(*add)[1] : nullptr);
+  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3], add ? &(*add)[2] : nullptr,
+               add ? &(*add)[3] : nullptr);
 }
 
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,

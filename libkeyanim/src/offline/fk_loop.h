@@ -16,10 +16,10 @@
 namespace keyanim::offline {
 
 // world_points of four frame rows in four AVX lanes (fk_v3.cpp), into out[0..4), each sized
-// 4 x the nodes; false, with nothing done, where this build has no AVX2 copy (not x86-64). The
-// caller checks the CPU.
+// 4 x the nodes, and under the add reading into out_add[0..4) when it is not null; false, with
+// nothing done, where this build has no AVX2 copy (not x86-64). The caller checks the CPU.
 bool world_points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes,
-                     PositionReading reading, double distance, Vec3* const* out);
+                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add);
 
 namespace {
 
@@ -78,13 +78,29 @@ inline bool is_root(const Joint& joint, size_t index) noexcept {
   return joint.parent < 0 || static_cast<size_t>(joint.parent) >= index;
 }
 
+// pos[j]: translation t from the parent's position and rotation m (a root's: t itself).
+template <class D>
+inline void place(std::array<D, 3>* pos, size_t j, int32_t parent, const std::array<D, 9>& m,
+                  const std::array<D, 3>& t) noexcept {
+  if (parent < 0) {
+    pos[j] = t;
+    return;
+  }
+  const std::array<D, 3>& pp = pos[parent];
+  pos[j] = {pp[0] + m[0] * t[0] + m[1] * t[1] + m[2] * t[2],
+            pp[1] + m[3] * t[0] + m[4] * t[1] + m[5] * t[2],
+            pp[2] + m[6] * t[0] + m[7] * t[1] + m[8] * t[2]};
+}
+
 // The one FK loop everything else uses, on one frame (double) or several in SIMD lanes. `values`
 // gives a channel's value (value(column)) and the sine and cosine of a rotation's
 // (sin_cos(column, s, c)), as D. pos and rot have room for every node. With `nodes`, only the nodes it marks (a set holding every ancestor of
-// its members) are computed.
-template <typename Values, typename D = typename Values::D>
-void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
-                const uint8_t* nodes = nullptr, PositionReading reading = PositionReading::replace) noexcept {
+// its members) are computed. With `pos_add`, the positions under the add reading go there as
+// well (`reading` then says replace): the rotations, most of the work, do not depend on the
+// reading, so both readings cost one pass, each position the same operations as its own pass.
+template <bool kBoth, typename Values, typename D>
+void pose_frame_readings(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
+                         const uint8_t* nodes, PositionReading reading, std::array<D, 3>* pos_add) noexcept {
   const bool add = reading == PositionReading::add;
   const D zero(0.0), one(1.0);
   const std::array<D, 9> identity{one, zero, zero, zero, one, zero, zero, zero, one};
@@ -95,6 +111,8 @@ void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>
     const bool root = is_root(joint, j);
     const std::array<D, 9>& parent_rot = root ? identity : rot[joint.parent];
     std::array<D, 3> t{D(joint.offset[0]), D(joint.offset[1]), D(joint.offset[2])};
+    [[maybe_unused]] std::array<D, 3> t_add;
+    if constexpr (kBoth) t_add = t;
     std::array<D, 9>& r = rot[j];
     r = parent_rot;
     for (size_t k = 0; k < joint.channels.size(); ++k) {
@@ -106,19 +124,22 @@ void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>
         post_rotate(r, channel_axis(type), sn, cs);
       } else {
         const size_t axis = static_cast<size_t>(channel_axis(type));
-        t[axis] = add ? D(joint.offset[axis]) + values.value(column) : values.value(column);
+        const D v = values.value(column);
+        t[axis] = add ? D(joint.offset[axis]) + v : v;
+        if constexpr (kBoth) t_add[axis] = D(joint.offset[axis]) + v;
       }
     }
-    if (root) {
-      pos[j] = t;
-    } else {
-      const std::array<D, 3>& pp = pos[joint.parent];
-      const std::array<D, 9>& m = parent_rot;
-      pos[j] = {pp[0] + m[0] * t[0] + m[1] * t[1] + m[2] * t[2],
-                pp[1] + m[3] * t[0] + m[4] * t[1] + m[5] * t[2],
-                pp[2] + m[6] * t[0] + m[7] * t[1] + m[8] * t[2]};
-    }
+    place(pos, j, root ? -1 : joint.parent, parent_rot, t);
+    if constexpr (kBoth) place(pos_add, j, root ? -1 : joint.parent, parent_rot, t_add);
   }
+}
+
+template <typename Values, typename D = typename Values::D>
+void pose_frame(const Skeleton& skeleton, const Values& values, std::array<D, 3>* pos, std::array<D, 9>* rot,
+                const uint8_t* nodes = nullptr, PositionReading reading = PositionReading::replace,
+                std::array<D, 3>* pos_add = nullptr) noexcept {
+  if (pos_add) return pose_frame_readings<true>(skeleton, values, pos, rot, nodes, reading, pos_add);
+  pose_frame_readings<false>(skeleton, values, pos, rot, nodes, reading, pos_add);
 }
 
 }  // namespace

@@ -66,42 +66,57 @@ struct FourRows {
 
 }  // namespace
 
-bool world_points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes,
-                     PositionReading reading, double distance, Vec3* const* out) {
+namespace {
+
+template <bool kBoth>
+void points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes, PositionReading reading,
+               double distance, Vec3* const* out, Vec3* const* out_add) {
   thread_local std::vector<std::array<Lanes4, 9>> rotations;
-  thread_local std::vector<std::array<Lanes4, 3>> positions;
+  thread_local std::vector<std::array<Lanes4, 3>> positions, positions_add;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n), positions.resize(n);
-  pose_frame(skeleton, FourRows{rows}, positions.data(), rotations.data(), nodes, reading);
+  if (kBoth && positions_add.size() < n) positions_add.resize(n);
+  pose_frame(skeleton, FourRows{rows}, positions.data(), rotations.data(), nodes, reading,
+             kBoth ? positions_add.data() : nullptr);
   const Lanes4 d(distance);
   alignas(32) double lanes[4];
   // Point k of node j, coordinate c, into the four outputs.
-  auto put = [&](Lanes4 x, size_t j, int k, int c) {
+  auto put = [&](Vec3* const* to, Lanes4 x, size_t j, int k, int c) {
     _mm256_store_pd(lanes, x.v);
-    for (int i = 0; i < 4; ++i) out[i][4 * j + size_t(k)][size_t(c)] = lanes[i];
+    for (int i = 0; i < 4; ++i) to[i][4 * j + size_t(k)][size_t(c)] = lanes[i];
   };
-  for (size_t j = 0; j < n; ++j) {
-    if (nodes && !nodes[j]) continue;
-    const std::array<Lanes4, 3>& p = positions[j];
-    const std::array<Lanes4, 9>& r = rotations[j];
-    for (int c = 0; c < 3; ++c) put(p[c], j, 0, c);
+  auto points = [&](Vec3* const* to, const std::array<Lanes4, 3>& p, const std::array<Lanes4, 9>& r, size_t j) {
+    for (int c = 0; c < 3; ++c) put(to, p[c], j, 0, c);
     if (distance > 0.0 && !skeleton.joints[j].end_site) {
       for (int axis = 0; axis < 3; ++axis)
-        for (int c = 0; c < 3; ++c) put(p[c] + d * r[size_t(3 * c + axis)], j, 1 + axis, c);
+        for (int c = 0; c < 3; ++c) put(to, p[c] + d * r[size_t(3 * c + axis)], j, 1 + axis, c);
     } else {
       for (int i = 0; i < 4; ++i) {
-        Vec3* q = &out[i][4 * j];
+        Vec3* q = &to[i][4 * j];
         q[1] = q[2] = q[3] = q[0];
       }
     }
+  };
+  for (size_t j = 0; j < n; ++j) {
+    if (nodes && !nodes[j]) continue;
+    points(out, positions[j], rotations[j], j);
+    if constexpr (kBoth) points(out_add, positions_add[j], rotations[j], j);
   }
+}
+
+}  // namespace
+
+bool world_points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes,
+                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add) {
+  if (out_add) points_v3<true>(skeleton, rows, nodes, reading, distance, out, out_add);
+  else points_v3<false>(skeleton, rows, nodes, reading, distance, out, nullptr);
   return true;
 }
 
 #else
 
 bool world_points_v3(const Skeleton&, const double* const*, const uint8_t*, PositionReading, double,
-                     Vec3* const*) {
+                     Vec3* const*, Vec3* const*) {
   return false;
 }
 

@@ -64,15 +64,16 @@ void measured_points(const Skeleton& skeleton, const double* frame_row, double s
 
 void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b, double shell,
                      PositionReading reading, std::vector<std::array<double, 3>>& points_a,
-                     std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes) {
+                     std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes,
+                     std::vector<std::array<double, 3>>* add_a, std::vector<std::array<double, 3>>* add_b) {
   static_assert(kPointsPerNode == 4, "world_points gives the node and its three shell points");
-  world_points(skeleton, row_a, row_b, nodes, reading, shell, points_a, points_b);  // node_points, two at once
+  world_points(skeleton, row_a, row_b, nodes, reading, shell, points_a, points_b, add_a, add_b);  // node_points, two at once
 }
 
 void measured_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, double shell,
                      PositionReading reading, std::array<std::vector<std::array<double, 3>>, 4>& points,
-                     const uint8_t* nodes) {
-  world_points(skeleton, rows, nodes, reading, shell, points);  // node_points, four at once
+                     const uint8_t* nodes, std::array<std::vector<std::array<double, 3>>, 4>* points_add) {
+  world_points(skeleton, rows, nodes, reading, shell, points, points_add);  // node_points, four at once
 }
 
 std::string point_name(const Skeleton& s, uint32_t node, uint32_t point) {
@@ -134,8 +135,8 @@ void ErrorAccumulator::add_frames(uint32_t frame, const std::array<const double*
   }
   // Both frames' points under every reading first, then each frame as add_frame takes it:
   // the same comparisons in the same order (the first of equal errors stays the worst).
-  const std::span<const PositionReading> readings = measured_readings(*skeleton_);
-  for (size_t r = 0; r < readings.size(); ++r) measured_points(*skeleton_, rows, shell_, readings[r], quad_[r]);
+  const std::span<const PositionReading> readings = measured_readings(*skeleton_);  // replace, then add
+  measured_points(*skeleton_, rows, shell_, readings[0], quad_[0], nullptr, readings.size() > 1 ? &quad_[1] : nullptr);
   for (size_t k = 0; k < 2; ++k) {
     std::fill(node_max_.begin(), node_max_.end(), 0.0);
     for (size_t r = 0; r < readings.size(); ++r)

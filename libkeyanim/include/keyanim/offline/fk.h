@@ -62,12 +62,17 @@ void world_positions(const Skeleton& skeleton, const double* row_a, const double
 // out[4 j + 1 + a] the point `distance` along column a of its world rotation (for an End Site,
 // or with distance 0, copies of its position), each computed as p + distance * R[.][a] from
 // what world_pose gives, bit for bit.
+// With add_a and add_b (`reading` replace), the points under the add reading too, bit for bit a
+// second call with it: the rotations are computed once for both.
 void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
-                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b);
-// Four frame rows at once, into out[0..4): bit for bit what the above gives for rows 0 and 1,
-// then 2 and 3; in four AVX lanes on x86-64-v3 machines (internal/cpu.h; KEYANIM_CPU caps it).
+                  PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
+                  std::vector<Vec3>* add_a = nullptr, std::vector<Vec3>* add_b = nullptr);
+// Four frame rows at once, into out[0..4) (and out_add, as above): bit for bit what the above
+// gives for rows 0 and 1, then 2 and 3; in four AVX lanes on x86-64-v3 machines
+// (internal/cpu.h; KEYANIM_CPU caps it).
 void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
-                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out);
+                  PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out,
+                  std::array<std::vector<Vec3>, 4>* out_add = nullptr);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values

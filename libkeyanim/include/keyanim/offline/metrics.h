@@ -60,15 +60,20 @@ void measured_points(const Skeleton& skeleton, const double* frame_row, double s
                      std::vector<std::array<double, 3>>& points);
 // The same for two frame rows at once (bit for bit two calls; faster): an original frame and
 // its decoding, say. With `nodes`, only the points of the nodes it marks (a set holding every
-// ancestor of its members) are computed; the others are left as they were.
+// ancestor of its members) are computed; the others are left as they were. With add_a and
+// add_b (`reading` replace), the points under the add reading too (bit for bit a call with
+// it, for much less than a second call).
 void measured_points(const Skeleton& skeleton, const double* row_a, const double* row_b, double shell,
                      PositionReading reading, std::vector<std::array<double, 3>>& points_a,
-                     std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes = nullptr);
+                     std::vector<std::array<double, 3>>& points_b, const uint8_t* nodes = nullptr,
+                     std::vector<std::array<double, 3>>* add_a = nullptr,
+                     std::vector<std::array<double, 3>>* add_b = nullptr);
 // Four frame rows at once (bit for bit two calls of the above, on rows 0 and 1, then 2 and 3;
 // faster still where the CPU has AVX2): two frames, original and decoded.
 void measured_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, double shell,
                      PositionReading reading, std::array<std::vector<std::array<double, 3>>, 4>& points,
-                     const uint8_t* nodes = nullptr);
+                     const uint8_t* nodes = nullptr,
+                     std::array<std::vector<std::array<double, 3>>, 4>* points_add = nullptr);
 // How many of a node's points are measured (1 or kPointsPerNode).
 inline uint32_t measured_point_count(const Joint& node, double shell) noexcept {
   return shell > 0.0 && !node.end_site ? kPointsPerNode : 1;

@@ -182,15 +182,18 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
       }
       original[k] = m.values.data() + size_t(f) * n_ch;
     }
-    for (const PositionReading reading : readings) {
-      if (pair == 2) {
-        measured_points(m.skeleton, {original[0], w.row[0].data(), original[1], w.row[1].data()}, shell, reading,
-                        w.points, w.pose.data());
-      } else {
-        measured_points(m.skeleton, original[0], w.row[0].data(), shell, reading, w.points[0], w.points[1],
-                        w.pose.data());
-      }
-      for (size_t k = 0; k < pair; ++k) add_errors(m.skeleton, tol, shell, w.points[2 * k], w.points[2 * k + 1], k, w);
+    // Under each reading (replace, then add: one FK pass poses both).
+    const bool both = readings.size() > 1;
+    if (pair == 2) {
+      measured_points(m.skeleton, {original[0], w.row[0].data(), original[1], w.row[1].data()}, shell, readings[0],
+                      w.points, w.pose.data(), both ? &w.points_add : nullptr);
+    } else {
+      measured_points(m.skeleton, original[0], w.row[0].data(), shell, readings[0], w.points[0], w.points[1],
+                      w.pose.data(), both ? &w.points_add[0] : nullptr, both ? &w.points_add[1] : nullptr);
+    }
+    for (const auto* points : {&w.points, &w.points_add}) {
+      for (size_t k = 0; k < pair; ++k) add_errors(m.skeleton, tol, shell, (*points)[2 * k], (*points)[2 * k + 1], k, w);
+      if (!both) break;
     }
     for (size_t k = 0; k < pair; ++k) {
       const uint32_t f = w.frames[i + k];

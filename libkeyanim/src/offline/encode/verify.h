@@ -111,6 +111,7 @@ struct VerifyScratch {
   std::array<std::vector<double>, 2> error;    // per node: the largest distance over the readings
   std::array<std::vector<uint8_t>, 2> shell_over;  // per node: a shell point is over
   std::array<std::vector<Vec3>, 4> points;     // original, decoded of frame 0; of frame 1
+  std::array<std::vector<Vec3>, 4> points_add; // the same under the add reading (when measured)
 };
 
 // Verifies the frames f of [first, first + count) marked in `marks`: decodes the channels of
