@@ -116,14 +116,15 @@ ErrorAccumulator::ErrorAccumulator(const Skeleton& skeleton, double shell, const
 
 void ErrorAccumulator::add_frame(uint32_t frame, const double* original, const double* decoded) {
   std::fill(node_max_.begin(), node_max_.end(), 0.0);
+  thread_local std::vector<Vec3> a, b;  // scratch, per thread (as in add_frames)
   for (const PositionReading reading : measured_readings(*skeleton_)) {
     if (decoded_skeleton_ == skeleton_) {
-      measured_points(*skeleton_, original, decoded, shell_, reading, a_, b_);
+      measured_points(*skeleton_, original, decoded, shell_, reading, a, b);
     } else {
-      measured_points(*skeleton_, original, shell_, reading, a_);
-      measured_points(*decoded_skeleton_, decoded, shell_, reading, b_);
+      measured_points(*skeleton_, original, shell_, reading, a);
+      measured_points(*decoded_skeleton_, decoded, shell_, reading, b);
     }
-    add_points(frame, reading, a_, b_);
+    add_points(frame, reading, a, b);
   }
   end_frame(original, decoded);
 }
@@ -136,11 +137,14 @@ void ErrorAccumulator::add_frames(uint32_t frame, const std::array<const double*
   // Both frames' points under every reading first, then each frame as add_frame takes it:
   // the same comparisons in the same order (the first of equal errors stays the worst).
   const std::span<const PositionReading> readings = measured_readings(*skeleton_);  // replace, then add
-  measured_points(*skeleton_, rows, shell_, readings[0], quad_[0], nullptr, readings.size() > 1 ? &quad_[1] : nullptr);
+  // Per thread, not per accumulator: a long clip's measurement holds an accumulator per window
+  // until they are merged (172 of them on 44,032 frames), and these points are scratch.
+  thread_local std::array<std::array<std::vector<Vec3>, 4>, 2> quad;  // per reading
+  measured_points(*skeleton_, rows, shell_, readings[0], quad[0], nullptr, readings.size() > 1 ? &quad[1] : nullptr);
   for (size_t k = 0; k < 2; ++k) {
     std::fill(node_max_.begin(), node_max_.end(), 0.0);
     for (size_t r = 0; r < readings.size(); ++r)
-      add_points(frame + uint32_t(k), readings[r], quad_[r][2 * k], quad_[r][2 * k + 1]);
+      add_points(frame + uint32_t(k), readings[r], quad[r][2 * k], quad[r][2 * k + 1]);
     end_frame(rows[2 * k], rows[2 * k + 1]);
   }
 }

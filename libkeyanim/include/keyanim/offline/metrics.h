@@ -110,8 +110,6 @@ class ErrorAccumulator {
   std::array<double, 2> reading_max_{};
   std::vector<double> joint_max_, channel_max_;
   std::vector<double> node_max_;  // scratch of add_frame: this frame's, per node
-  std::vector<std::array<double, 3>> a_, b_;
-  std::array<std::array<std::vector<std::array<double, 3>>, 4>, 2> quad_;  // add_frames: per reading
   void add_points(uint32_t frame, PositionReading reading, const std::vector<std::array<double, 3>>& original,
                   const std::vector<std::array<double, 3>>& decoded);
   void end_frame(const double* original_row, const double* decoded_row);
