@@ -365,6 +365,10 @@ Clip to_clip(const EncodedClip& clip) {
   src.skeleton = clip.skeleton;
   src.skeleton.assign_channel_columns();
   src.channels.reserve(clip.channels.size());
+  size_t keys = 0;  // the key arrays at their size at once: growing them would hold up to 3x
+  for (const auto& c : clip.channels) keys += c.frames.size();
+  src.frames.reserve(keys);
+  src.q.reserve(keys);
   for (const auto& c : clip.channels) {
     internal::SourceChannel sc;
     sc.interp = c.interp;
