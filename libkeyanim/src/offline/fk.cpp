@@ -222,7 +222,8 @@ void world_points(const Skeleton& skeleton, const double* row_a, const double* r
   thread_local std::vector<std::array<Lanes2, 3>> positions, positions_add;
   const size_t n = skeleton.joints.size();
   const bool both = add_a && add_b;
-  if (rotations.size() < n) rotations.resize(n), positions.resize(n), positions_add.resize(n);
+  if (rotations.size() < n) rotations.resize(n), positions.resize(n);
+  if (both && positions_add.size() < n) positions_add.resize(n);
   out_a.resize(4 * n), out_b.resize(4 * n);
   if (both) add_a->resize(4 * n), add_b->resize(4 * n);
   pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading,
@@ -255,11 +256,9 @@ void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& 
       for (size_t i = 0; i < 4; ++i) (*out_add)[i].resize(4 * skeleton.joints.size()), points_add[i] = (*out_add)[i].data();
     if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points, out_add ? points_add : nullptr)) return;
   }
-  std::array<std::vector<Vec3>, 4>* add = out_add;
-  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1], add ? &(*add)[0] : nullptr,
-               add ? &(*add)[1] : nullptr);
-  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3], add ? &(*add)[2] : nullptr,
-               add ? &(*add)[3] : nullptr);
+  auto add = [&](size_t i) { return out_add ? &(*out_add)[i] : nullptr; };
+  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1], add(0), add(1));
+  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3], add(2), add(3));
 }
 
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
