@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "corpus_files.h"
+#include "report_checks.h"
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/metrics.h"
@@ -756,17 +757,6 @@ TEST_CASE("metrics: an accumulator fed two frames at a time reports what one fra
   // add_frames is two add_frame calls to the bit, including which of equal errors is the worst
   // (the first): the position-channel motion below has equal errors on all four frames and both
   // readings; the CMU take's decoding is perturbed by a pseudo-random amount on every channel.
-  auto same = [](const keyanim::offline::ErrorReport& a, const keyanim::offline::ErrorReport& b) {
-    CHECK(a.max_error == b.max_error);
-    CHECK(a.rms_error == b.rms_error);
-    CHECK(a.worst_joint == b.worst_joint);
-    CHECK(a.worst_point == b.worst_point);
-    CHECK(a.worst_frame == b.worst_frame);
-    CHECK(a.worst_reading == b.worst_reading);
-    CHECK(a.reading_max == b.reading_max);
-    CHECK(a.joint_max == b.joint_max);
-    CHECK(a.channel_max == b.channel_max);
-  };
   Motion ties;
   ties.skeleton = skeleton_of({joint("Hips", -1, {0, 0, 0}, {kZr}), joint("Arm", 0, {0, 5, 0}, {kXp, kYp, kZp, kZr}),
                                end_site(1, {3, 0, 0})});
@@ -794,6 +784,6 @@ TEST_CASE("metrics: an accumulator fed two frames at a time reports what one fra
     const auto a = one.report(original->frame_count), b = two.report(original->frame_count);
     CHECK(a.max_error > 0.0);
     CHECK(a.both_readings == (original == &ties));
-    same(a, b);
+    keyanim::test::check_same_report(b, a);
   }
 }

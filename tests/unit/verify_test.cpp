@@ -10,6 +10,7 @@
 #include "keyanim/offline/decode.h"
 #include "keyanim/offline/metrics.h"
 #include "offline/encode/verify.h"
+#include "report_checks.h"
 #include "shell_reference.h"
 
 using namespace keyanim;
@@ -260,14 +261,7 @@ TEST_SUITE("verify") {
     const Motion decoded = decode_motion(to_clip(clip));
     const ErrorReport want = measure_error(m, decoded, 0.25);
     for (unsigned threads : {1u, 2u, 3u}) {
-      const ErrorReport got = measure_encoded(m, clip, 0.25, threads);
-      CHECK(got.max_error == want.max_error);
-      CHECK(got.rms_error == want.rms_error);
-      CHECK(got.worst_frame == want.worst_frame);
-      CHECK(got.worst_joint == want.worst_joint);
-      CHECK(got.worst_point == want.worst_point);
-      CHECK(got.joint_max == want.joint_max);
-      CHECK(got.channel_max == want.channel_max);
+      keyanim::test::check_same_report(measure_encoded(m, clip, 0.25, threads), want);
     }
   }
 }
