@@ -9,13 +9,21 @@
 
 namespace keyanim {
 
+namespace internal {
+// Eight curves' segment states, field by field: the SIMD evaluation of 8 (or 4) curves reads
+// each field with one load, and a refresh writes a curve's fields through one address.
+struct SegmentLanes {
+  alignas(32) float lo[8], hi[8], k0[8], k1[8], p0[8], d[8], m0[8], m1[8], value[8];
+  uint32_t linear[8], direct[8];  // all ones / zeros, for select
+  float result[8];                // before the scatter to channels
+};
+}  // namespace internal
+
 struct Cursor::State {
   std::shared_ptr<const internal::Image> image;
-  // Per curve, structure of arrays: the segment state of sampler.h's Segment, for the SIMD
-  // evaluation of every curve at once.
-  std::vector<float> lo, hi, k0, k1, p0, d, m0, m1, value;
-  std::vector<uint32_t> linear, direct;  // all ones / zeros, for select
-  std::vector<float> result;             // per curve, before the scatter to channels
+  // Curve i's segment state (sampler.h's Segment, prepared for the polynomial): lanes[i / 8],
+  // lane i % 8; the last group's lanes past the curves are padding.
+  std::vector<internal::SegmentLanes> lanes;
   // Per curve, its keys around the current segment and where its record continues: playback
   // crosses a key every few frames, and the next segment is then one key read away.
   std::vector<internal::KeyStream> streams;

@@ -169,6 +169,26 @@ TEST_CASE("the cursor never changes a result") {
   for (size_t c = 0; c < x.size(); ++c) CHECK(same_bits(x[c], y[c]));
 }
 
+// Playback refreshes the curves whose segment a step left in batches of up to 32 (cursor.cpp):
+// a clip of over a hundred curves, stepped, jumped and swept back, has batches that are full,
+// partial and flushed at the last curve, with clamped and interior curves mixed in each.
+TEST_CASE("the cursor's batched refresh changes no result when many curves go stale at once") {
+  const Clip clip = keyanim::offline::to_clip(random_clip(9, 300, 45));
+  const uint32_t n = clip.channel_count();
+  REQUIRE(n > 100);
+  std::vector<float> a(n), b(n);
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  uint64_t s = 5, mismatches = 0;
+  for (int i = 0; i < 2400; ++i) {
+    const double x = i < 800 ? i * 0.37 - 3.0 : i < 1600 ? 310.0 - (i - 800) * 1.7 : double(lcg(s) % 32000) / 97.0 - 8.0;
+    REQUIRE(clip.sample(x, a) == Status::ok);
+    REQUIRE(clip.sample(x, b, &cursor) == Status::ok);
+    for (uint32_t c = 0; c < n; ++c) mismatches += !same_bits(a[c], b[c]);
+  }
+  CHECK(mismatches == 0);
+}
+
 TEST_CASE("sample_time sample_channels and argument errors") {
   const Clip clip = keyanim::offline::to_clip(vector_rules());
   std::vector<float> all(clip.channel_count()), some(3);
