@@ -165,9 +165,11 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
   // Translations: OFFSETs (and reserved = 0), then the position channels.
   for (uint32_t node = first; node < last; ++node)
     std::memcpy(out[node - first].translation, rig.node_offset.data() + 4 * size_t(node), 4 * sizeof(float));
+  // A whole pose (the usual call) needs no search for where its nodes start and end.
+  const bool whole = first == 0 && last == rig.skeleton.joints.size();
   const Rig::Move* moves = rig.moves.data();
   const auto by_node = [](const Rig::Move& m, uint32_t node) { return m.node < node; };
-  const Rig::Move* m = std::lower_bound(moves, moves + rig.moves.size(), first, by_node);
+  const Rig::Move* m = whole ? moves : std::lower_bound(moves, moves + rig.moves.size(), first, by_node);
   for (; m != moves + rig.moves.size() && m->node < last; ++m) {
     const float v = values[m->column - column0];
     float& t = out[m->node - first].translation[m->axis];
@@ -176,7 +178,8 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
   // Rotations, group by group: the group's nodes in [first, last).
   for (const Rig::RotationGroup& g : rig.rot_groups) {
     const uint32_t* node = rig.group_node.data() + g.node_first;
-    const uint32_t begin = lower_index(node, g.node_count, first), end = lower_index(node, g.node_count, last);
+    const uint32_t begin = whole ? 0 : lower_index(node, g.node_count, first);
+    const uint32_t end = whole ? g.node_count : lower_index(node, g.node_count, last);
     group_rotations<kWide>(rig, g, begin, end, values, column0, first, out);
   }
 }
