@@ -26,7 +26,8 @@ Status Cursor::prepare(const Clip& clip) noexcept {
     auto st = std::make_unique<State>();
     const Image& img = ClipAccess::image(clip);
     st->image = ClipAccess::shared(clip);
-    // An empty range (lo = +inf) makes every curve refresh; padding lanes are never used.
+    // An empty range (lo = +inf) makes every curve refresh; the padding lanes of the last group
+    // are evaluated with the others, and their results never read.
     internal::SegmentLanes empty{};
     std::fill(std::begin(empty.lo), std::end(empty.lo), std::numeric_limits<float>::infinity());
     std::fill(std::begin(empty.k1), std::end(empty.k1), 1.0f);
@@ -92,8 +93,8 @@ KEYANIM_INLINE inline bool position_stream(const Image& img, Cursor::State& st, 
 }
 
 // Curve i's state from its segment's key frames and Appendix A's operands.
-KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint32_t i, float f, float k0, float k1,
-                 const Operands<float>& o) noexcept {
+KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint32_t i, float f, float k0,
+                                       float k1, const Operands<float>& o) noexcept {
   const Slot at = slot(st, i);
   SegmentLanes& g = at.g;
   const uint32_t l = at.l;
