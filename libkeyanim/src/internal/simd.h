@@ -53,6 +53,8 @@ inline void transpose(F4& a, F4& b, F4& c, F4& d) { _MM_TRANSPOSE4_PS(a.v, b.v, 
 inline uint32_t outside(F4 x, F4 lo, F4 hi) {
   return static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(_mm_cmpnle_ps(lo.v, x.v), _mm_cmpnlt_ps(x.v, hi.v))));
 }
+// Bit i set when lane i's sign bit is (a lane mask's: when the lane is all ones).
+inline uint32_t sign_bits(F4 x) { return static_cast<uint32_t>(_mm_movemask_ps(x.v)); }
 inline void transpose(I4& a, I4& b, I4& c, I4& d) {
   const __m128i t0 = _mm_unpacklo_epi32(a.v, b.v), t1 = _mm_unpacklo_epi32(c.v, d.v);
   const __m128i t2 = _mm_unpackhi_epi32(a.v, b.v), t3 = _mm_unpackhi_epi32(c.v, d.v);
@@ -108,6 +110,15 @@ inline F4 mask_or(F4 a, F4 b) { F4 ones; const uint32_t all = ~0u; for (auto& x 
 inline uint32_t outside(F4 x, F4 lo, F4 hi) {
   uint32_t r = 0;
   for (int i = 0; i < 4; ++i) r |= uint32_t(!(lo.v[i] <= x.v[i] && x.v[i] < hi.v[i])) << i;
+  return r;
+}
+inline uint32_t sign_bits(F4 x) {
+  uint32_t r = 0;
+  for (int i = 0; i < 4; ++i) {
+    uint32_t b;
+    std::memcpy(&b, &x.v[i], 4);
+    r |= (b >> 31) << i;
+  }
   return r;
 }
 template <class T>

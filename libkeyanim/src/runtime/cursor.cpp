@@ -92,23 +92,20 @@ KEYANIM_INLINE inline bool position_stream(const Image& img, Cursor::State& st, 
   return true;
 }
 
-// Curve i's state from its segment's key frames and Appendix A's operands.
+// Curve i's state from its segment's key frames and Appendix A's operands. At f == K_j the
+// polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's v_j, when the operands are
+// finite and p0 is not -0 (-0 + +0 is +0): `exact_at_key`; else K_j is a direct state of its own.
 KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint32_t i, float f, float k0,
-                                       float k1, const Operands<float>& o) noexcept {
+                                       float k1, const Operands<float>& o, bool exact_at_key) noexcept {
   const Slot at = slot(st, i);
   SegmentLanes& g = at.g;
   const uint32_t l = at.l;
   g.k0[l] = k0, g.k1[l] = k1, g.p0[l] = o.p0, g.d[l] = o.d, g.m0[l] = o.m0, g.m1[l] = o.m1;
-  g.value[l] = o.p0;
   g.linear[l] = img.curve_linear[i];
-  // At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's v_j, when the
-  // operands are finite and p0 is not -0 (-0 + +0 is +0); else K_j is a direct state of its own.
-  const bool exact_at_key = std::isfinite(o.d) && std::isfinite(o.m0) && std::isfinite(o.m1) &&
-                            !(o.p0 == 0.0f && std::signbit(o.p0));
-  if (exact_at_key) {
+  if (exact_at_key) [[likely]] {
     g.lo[l] = k0, g.hi[l] = k1, g.direct[l] = 0u;
   } else if (f == k0) {
-    g.lo[l] = k0, g.hi[l] = std::nextafter(k0, kInf), g.direct[l] = ~0u;
+    g.lo[l] = k0, g.hi[l] = std::nextafter(k0, kInf), g.direct[l] = ~0u, g.value[l] = o.p0;
   } else {
     g.lo[l] = std::nextafter(k0, kInf), g.hi[l] = k1, g.direct[l] = 0u;
   }
@@ -136,10 +133,16 @@ KEYANIM_INLINE inline void set_segments(const Image& img, Cursor::State& st, con
   const float* s = img.curve_s.data();
   const F4 sv = F4::set(s[curve[0]], s[curve[1]], s[curve[2]], s[curve[3]]);
   const Operands<F4> o = cardinal_operands(p[0], p[1], p[2], p[3], sv, a0, a1);
+  // set_segment's exact_at_key, lane by lane: x - x is +0 exactly when x is finite.
+  const F4 zero(0.0f);
+  const uint32_t finite = sign_bits(cmp_eq(o.d - o.d, zero)) & sign_bits(cmp_eq(o.m0 - o.m0, zero)) &
+                          sign_bits(cmp_eq(o.m1 - o.m1, zero));
+  const uint32_t exact = finite & ~(sign_bits(cmp_eq(o.p0, zero)) & sign_bits(o.p0));
   alignas(16) float out[6][4];
   k0.store(out[0]), k1.store(out[1]), o.p0.store(out[2]), o.d.store(out[3]), o.m0.store(out[4]), o.m1.store(out[5]);
   for (uint32_t l = 0; l < lanes; ++l)
-    set_segment(img, st, curve[l], f, out[0][l], out[1][l], {out[2][l], out[3][l], out[4][l], out[5][l]});
+    set_segment(img, st, curve[l], f, out[0][l], out[1][l], {out[2][l], out[3][l], out[4][l], out[5][l]},
+                (exact >> l) & 1);
 }
 
 // Refreshes the curves whose segment f left (`stale`, count of them): each one's stream

@@ -189,6 +189,47 @@ TEST_CASE("the cursor's batched refresh changes no result when many curves go st
   CHECK(mismatches == 0);
 }
 
+// At a key frame the cursor's polynomial gives the key's value only when the operands are
+// finite and the value is not -0 (cursor.cpp, set_segment); elsewhere the key is a direct state.
+// Channel 0: values +0, -0, +0, -0 (q of both signs times a step that rounds them to zero);
+// channel 1: +-3e38, whose differences overflow to infinity.
+TEST_CASE("the cursor gives a key's own value at its frame when the value is -0 or the operands overflow") {
+  EncodedClip e;
+  e.skeleton.joints.push_back(node("root", -1, 0, 0, 0, {CT::z_rotation, CT::x_rotation}));
+  e.skeleton.joints.push_back(node("end", 0, 0, 1, 0, {}, true));
+  e.frame_count = 40;
+  e.frame_time = 1.0 / 30.0;
+  e.tangent_rule = TangentRule::step_adjusted;
+  const int64_t q[2][4] = {{1, -1, 2, -3}, {3, -3, 3, -3}};
+  const double step[2] = {1e-300, 1e38};
+  for (int c = 0; c < 2; ++c) {
+    EncodedChannel ch;
+    ch.interp = kCard;
+    ch.tension = 0.0f;
+    ch.step = step[c];
+    ch.frames = {0, 10, 25, 39};
+    ch.q.assign(q[c], q[c] + 4);
+    e.channels.push_back(std::move(ch));
+  }
+  const Clip clip = keyanim::offline::to_clip(e);
+  REQUIRE(clip.channel_count() == 2);
+  std::vector<float> a(2), b(2);
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  uint64_t mismatches = 0, minus_zero = 0;
+  for (double x = 0.0; x <= 39.0; x += 0.5) {
+    REQUIRE(clip.sample(x, a) == Status::ok);
+    REQUIRE(clip.sample(x, b, &cursor) == Status::ok);
+    for (int c = 0; c < 2; ++c) mismatches += !same_bits(a[c], b[c]);
+    minus_zero += (x == 10.0 || x == 39.0) && same_bits(b[0], -0.0f);
+  }
+  CHECK(mismatches == 0);
+  CHECK(minus_zero == 2);  // the test reaches the case: the -0 keys come back as -0
+  float v = 0.0f;
+  REQUIRE(clip.sample_channel(1, 10.0f, v) == Status::ok);
+  CHECK(v == -3e38f);
+}
+
 TEST_CASE("sample_time sample_channels and argument errors") {
   const Clip clip = keyanim::offline::to_clip(vector_rules());
   std::vector<float> all(clip.channel_count()), some(3);
