@@ -180,6 +180,7 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
   constexpr uint32_t kBatch = 2048;
   float values[kBatch];
   if (img.interp.size() <= kBatch) {
+    internal::prefetch_pose_tables(img, out.data(), nodes);
     internal::sample_all(img, f, values);
     internal::local_transforms(img, 0, nodes, values, reading, out.data());
     return Status::ok;

@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "internal/cpu.h"
+#include "internal/prefetch.h"
 #include "internal/trig.h"
 
 namespace keyanim::internal {
@@ -226,6 +227,16 @@ void local_transforms(const Image& img, uint32_t first, uint32_t last, const flo
   if (first >= last) return;
   cpu_level() == CpuLevel::v3 ? local_v3(img, first, last, values, reading, out)
                               : local_plain(img, first, last, values, reading, out);
+}
+
+void prefetch_pose_tables(const Image& img, Transform* out, uint32_t nodes) noexcept {
+  const Rig& rig = *img.rig;
+  prefetch_array(rig.rot_groups.data(), rig.rot_groups.size());
+  prefetch_array(rig.group_column.data(), rig.group_column.size());
+  prefetch_array(rig.group_node.data(), rig.group_node.size());
+  prefetch_array(rig.node_offset.data(), rig.node_offset.size());
+  prefetch_array(rig.moves.data(), rig.moves.size());
+  prefetch_array<true>(out, nodes);
 }
 
 void compose_model(const Image& img, Transform* out) noexcept {

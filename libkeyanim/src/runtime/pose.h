@@ -13,6 +13,11 @@ namespace keyanim::internal {
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
                       Transform* out) noexcept;
 
+// Asks for the cache lines local_transforms reads (the rig's pose tables) and writes (the
+// whole pose `out`, `nodes` transforms) of a whole pose, before the channels are sampled: a
+// cold pose's misses then overlap the sampling instead of coming one after another.
+void prefetch_pose_tables(const Image& img, Transform* out, uint32_t nodes) noexcept;
+
 // Turns local transforms of every node (out[i] for node i) into model-space ones, in place.
 void compose_model(const Image& img, Transform* out) noexcept;
 
