@@ -305,20 +305,19 @@ constexpr uint64_t kRecordBytesBound = 512;
 // that runs backwards is skipped. Measured in bench_vs_acl (cold_local, keyanim / ACL):
 // CMU 01_01 2.62 -> 2.09, Bandai bow_feminine_001 4.79 -> 2.82.
 [[gnu::always_inline]] inline void prefetch_pose(const Image& img, const BlockView& view, uint32_t block) noexcept {
-  const size_t n = img.curves.size(), lanes = (n + 3) & ~size_t(3);
-  prefetch_array(view.offsets, img.block_curves);
-  prefetch_array(img.curves.data(), n);
-  for (const float* a : {img.curve_s.data(), img.first_frame.data(), img.last_frame.data(), img.first_value.data(),
-                         img.last_value.data()})
-    prefetch_array(a, lanes);
-  prefetch_array(img.curve_linear.data(), lanes);
-  prefetch_array(img.curve_channel.data(), n);
-  prefetch_array(img.fixed_channels.data(), img.fixed_channels.size());
+  // The fixed channels and the per-curve arrays are one range of the image (spec 9.2's order).
+  using L = ImageLayout;
+  static_assert(L::curves == L::fixed_channels + 1 && L::curve_channel == L::curves + 7,
+                "fixed_channels, curves, curve_s .. curve_linear, curve_channel are consecutive");
+  const auto* from = reinterpret_cast<const uint8_t*>(img.fixed_channels.data());
+  const auto* to = reinterpret_cast<const uint8_t*>(img.curve_channel.data() + img.curve_channel.size());
+  prefetch_bytes(from, size_t(to - from));
   if (!img.fixed_channels.empty()) prefetch_array(img.fixed_value.data(), img.fixed_value.size());  // by channel
   if (img.block_curves == 0) return;
-  const uint64_t from = view.offsets[0];
-  const uint64_t to = block + 1 < img.block_count ? view.offsets[img.block_curves] : img.payload.size();
-  if (from < to) prefetch_array(view.payload + from, std::min(to - from, img.block_curves * kRecordBytesBound));
+  prefetch_array(view.offsets, img.block_curves);
+  const uint64_t first = view.offsets[0];
+  const uint64_t last = block + 1 < img.block_count ? view.offsets[img.block_curves] : img.payload.size();
+  if (first < last) prefetch_array(view.payload + first, std::min(last - first, img.block_curves * kRecordBytesBound));
 }
 
 // Every curve in order, written to its channel; the fixed channels separately. The per-curve
