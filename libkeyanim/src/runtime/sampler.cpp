@@ -302,8 +302,9 @@ constexpr uint64_t kRecordBytesBound = 512;
 // together (block-major offsets), so one range holds them, where a prefetch per record a few
 // curves ahead (the earlier design) cost an instruction per curve and missed the first ones.
 // A runtime-profile file's offsets are bounded by its payload but not ordered, so a range
-// that runs backwards is skipped. Measured in bench_vs_acl (cold_local, keyanim / ACL):
-// CMU 01_01 2.62 -> 2.09, Bandai bow_feminine_001 4.79 -> 2.82.
+// that runs backwards is skipped. Measured in bench_vs_acl against 50ee059 (two interleaved
+// runs of each, cold_local median, keyanim / ACL): CMU 2.48 and 2.74 -> 1.83 and 1.87, Bandai
+// 3.47 and 3.33 -> 1.89 and 2.57; a warm local pose costs about 3% more instructions.
 [[gnu::always_inline]] inline void prefetch_pose(const Image& img, const BlockView& view, uint32_t block) noexcept {
   // The fixed channels and the per-curve arrays are one range of the image (spec 9.2's order).
   using L = ImageLayout;
