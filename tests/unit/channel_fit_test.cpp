@@ -106,6 +106,31 @@ TEST_SUITE("channel_fit") {
     CHECK(scratch_clean(scratch));
   }
 
+  TEST_CASE("the first fit chooses the interpolation: later rounds refit only the winner") {
+    // A smooth wave, where Cardinal needs far fewer keys, and a sawtooth of straight ramps with
+    // corners off the frames, where linear does.
+    std::vector<double> saw(600);
+    for (uint32_t f = 0; f < saw.size(); ++f) saw[f] = 2.0 * std::fabs(std::fmod(f + 0.5, 37.0) - 18.5);
+    for (const auto& [y, winner] : {std::pair{wavy(600, 0.7), Interpolation::cardinal}, std::pair{saw, Interpolation::linear}}) {
+      std::vector<float> factor(600, 1.0f);
+      const Tolerance tol{0.05, factor.data()};
+      ChannelFitter fitter{ChannelFitOptions{}};
+      FitScratch scratch;
+      scratch.y = y;
+      const EncodedChannel first = fitter.fit(tol, 0.0625, nullptr, scratch);
+      CHECK(first.interp == winner);
+      CHECK(fitter.candidate_count() == 1);
+      // Tighter everywhere: the winner's keys are refined, and still within the tolerance.
+      std::fill(factor.begin(), factor.end(), 0.5f);
+      const EncodedChannel tighter = fitter.fit(tol, 0.03125, nullptr, scratch);
+      CHECK(tighter.interp == winner);
+      CHECK(tighter.frames.size() >= first.frames.size());
+      CHECK(worst_ratio(tighter, y, tol, TangentRule::step_adjusted) <= 1.0);
+      CHECK(fitter.candidate_count() == 1);
+      CHECK(scratch_clean(scratch));
+    }
+  }
+
   TEST_CASE("constant channels cost one key, zero channels none") {
     std::vector<float> factor(50, 1.0f);
     const Tolerance tol{0.1, factor.data()};

@@ -330,7 +330,7 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
     if (opt_.force_linear) {
       add(Interpolation::linear, opt_.tension);
     } else {
-      // A fitted tension is kept only if it ends up cheaper (checked at every fit below).
+      // A fitted tension is kept only if it is cheaper (keep_fewest).
       float s = 0.0f;
       add(Interpolation::cardinal, opt_.tension, opt_.fit_tension ? &s : nullptr);
       if (opt_.fit_tension) add(Interpolation::cardinal, s_to_tension(s));
@@ -346,11 +346,15 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
       c.step = step;
     }
   }
-  size_t best = 0;
-  for (size_t i = 1; i < candidates_.size(); ++i)
-    if (candidates_[i].keys.size() < candidates_[best].keys.size()) best = i;
-  const Candidate& b = candidates_[best];
+  keep_fewest();
+  const Candidate& b = candidates_.front();  // the first of a tie, as before any was dropped
   return channel_at(y, b.interp, b.tension, b.step, b.keys);
+}
+
+void ChannelFitter::keep_fewest() {
+  size_t fewest = candidates_.front().keys.size();
+  for (const Candidate& c : candidates_) fewest = std::min(fewest, c.keys.size());
+  std::erase_if(candidates_, [&](const Candidate& c) { return c.keys.size() > fewest; });
 }
 
 }  // namespace keyanim::offline

@@ -144,7 +144,8 @@ EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vect
                                    double step, const ChannelFitOptions& options, FitScratch& scratch);
 
 // The candidate fits of one channel in error mode (Cardinal with the given or fitted tension,
-// and linear), kept across the encoder's tightening rounds as their key frames.
+// and linear); the first fit's winner is kept across the encoder's tightening rounds as its key
+// frames.
 class ChannelFitter {
  public:
   explicit ChannelFitter(const ChannelFitOptions& options) : opt_(options) {}
@@ -152,8 +153,18 @@ class ChannelFitter {
   // tolerances, whose values changed only at `changed` frames since the last call (null:
   // anywhere); returns the candidate with the fewest keys.
   EncodedChannel fit(Tolerance tol, double step, const std::vector<uint32_t>* changed, FitScratch& scratch);
+  // How many candidates the next fit refits (keep_fewest).
+  size_t candidate_count() const { return candidates_.size(); }
 
  private:
+  // Keeps only the candidates with the fewest keys (all of them on a tie): the interpolation
+  // and tension are chosen by the first fit, and the rounds that follow refine the winner
+  // alone. Measured on the corpus (bench_codec, 42 files) against refitting every candidate
+  // each round and taking the fewest keys: 0.6% fewer bytes at 0.05% of the skeleton size and
+  // 0.2% fewer at 0.5%, for 24% fewer encoding instructions on CMU 01_01 (callgrind, one
+  // thread). Keeping also those within 5% of the fewest: 0.3% and 0.5% fewer bytes; within 10%
+  // plus 2 keys: 0.05% fewer and 0.2% more, for 4% fewer instructions.
+  void keep_fewest();
   struct Candidate {
     Interpolation interp;
     float tension;
