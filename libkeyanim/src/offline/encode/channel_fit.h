@@ -162,8 +162,11 @@ class ChannelFitter {
   // alone. Measured on the corpus (bench_codec, 42 files) against refitting every candidate
   // each round and taking the fewest keys: 0.6% fewer bytes at 0.05% of the skeleton size and
   // 0.2% fewer at 0.5%, for 24% fewer encoding instructions on CMU 01_01 (callgrind, one
-  // thread). Keeping also those within 5% of the fewest: 0.3% and 0.5% fewer bytes; within 10%
-  // plus 2 keys: 0.05% fewer and 0.2% more, for 4% fewer instructions.
+  // thread; 12% on Bandai walk_normal_001). Keeping also those within 5% of the fewest: 0.3%
+  // and 0.5% fewer bytes; within 10% plus 2 keys: 0.05% fewer and 0.2% more, for 4% fewer
+  // instructions. The cost: Bandai 30 fps clips are 0.7% larger (bench_vs_acl's median, 0.782
+  // -> 0.787 of ACL's bytes); keeping every candidate through the second fit too keeps them as
+  // they were, for 17.5% fewer instructions on 01_01 and 3.8% on the Bandai walk.
   void keep_fewest();
   struct Candidate {
     Interpolation interp;
