@@ -111,7 +111,9 @@ TEST_SUITE("channel_fit") {
     // corners off the frames, where linear does.
     std::vector<double> saw(600);
     for (uint32_t f = 0; f < saw.size(); ++f) saw[f] = 2.0 * std::fabs(std::fmod(f + 0.5, 37.0) - 18.5);
-    for (const auto& [y, winner] : {std::pair{wavy(600, 0.7), Interpolation::cardinal}, std::pair{saw, Interpolation::linear}}) {
+    const std::pair<std::vector<double>, Interpolation> cases[] = {{wavy(600, 0.7), Interpolation::cardinal},
+                                                                    {saw, Interpolation::linear}};
+    for (const auto& [y, winner] : cases) {
       std::vector<float> factor(600, 1.0f);
       const Tolerance tol{0.05, factor.data()};
       ChannelFitter fitter{ChannelFitOptions{}};
