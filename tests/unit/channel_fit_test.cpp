@@ -2,6 +2,7 @@
 // evaluation, refits that continue from the keys, and the scratch a fit leaves behind.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -104,6 +105,44 @@ TEST_SUITE("channel_fit") {
     CHECK(finer.step == 0.0075);
     CHECK(worst_ratio(finer, y, tol, TangentRule::step_adjusted) <= 1.0);
     CHECK(scratch_clean(scratch));
+  }
+
+  TEST_CASE("holds() is true exactly when a refit would return the channel as it is") {
+    const std::vector<double> y = wavy(800, 1.1);
+    std::vector<float> factor(800, 1.0f);
+    const Tolerance tol{0.02, factor.data()};
+    ChannelFitter fitted{ChannelFitOptions{}};
+    FitScratch scratch;
+    scratch.y = y;
+    const EncodedChannel first = fitted.fit(tol, 0.03, nullptr, scratch);
+    // Random tightenings of a few frames, each on a copy of the fitter: holds() against what
+    // the refit (the path it replaces) returns.
+    std::mt19937 rng(11);
+    int held = 0, refitted = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      std::vector<float> tighter(800, 1.0f);
+      std::vector<uint32_t> changed;
+      for (int k = 0; k < 3; ++k) changed.push_back(uint32_t(rng() % 800));
+      std::sort(changed.begin(), changed.end());
+      changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+      for (uint32_t f : changed) tighter[f] = 0.2f + 0.8f * float(rng() % 1000) / 1000.0f;
+      const Tolerance t{0.02, tighter.data()};
+      ChannelFitter copy = fitted;
+      const bool holds = copy.holds(t, 0.03, changed, y.data());
+      const EncodedChannel again = copy.fit(t, 0.03, &changed, scratch);
+      CHECK(holds == (again.frames == first.frames && again.q == first.q));
+      (holds ? held : refitted) += 1;
+      // At another step the keys are requantized: never held.
+      CHECK_FALSE(fitted.holds(t, 0.015, changed, y.data()));
+    }
+    CHECK(held > 30);  // both answers occur
+    CHECK(refitted > 30);
+    CHECK(scratch_clean(scratch));
+    // A constant channel is not a candidate: never held.
+    ChannelFitter flat{ChannelFitOptions{}};
+    scratch.y.assign(800, 0.001);
+    flat.fit(tol, 0.03, nullptr, scratch);
+    CHECK_FALSE(flat.holds(tol, 0.03, {5}, scratch.y.data()));
   }
 
   TEST_CASE("the first fit chooses the interpolation: later rounds refit only the winner") {

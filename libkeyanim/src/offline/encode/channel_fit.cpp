@@ -16,6 +16,50 @@ int64_t quantize(double y, double step) noexcept {
   return frac >= 0.5 ? t + 1 : frac <= -0.5 ? t - 1 : t;
 }
 
+namespace {
+
+// The decoder's value of a key: the signal quantized with `step`.
+float key_value(double y, double step) noexcept { return dequantize(quantize(y, step), step); }
+
+// The largest |error| / tolerance over the frames strictly inside [start, end] of the segment
+// `ops`, and the first frame that has it (start + 1 if none is above 0). Long segments go in
+// chunks the compiler turns into vector instructions: the same operations on every frame
+// (segment_u with its constants hoisted), then the first frame with the largest ratio. Frames
+// are below 2^31, so converting them as signed gives the same floats.
+double worst_ratio(const double* y, const Tolerance& tol, const SegmentOperands& ops, uint32_t start, uint32_t end,
+                   uint32_t& arg) {
+  constexpr uint32_t kShortSegment = 8;  // shorter segments skip the vectorized loop
+  double worst = 0.0;
+  arg = start + 1;
+  if (end - start <= kShortSegment) {
+    for (uint32_t f = start + 1; f < end; ++f) {
+      const float v = eval_operands(ops, segment_u(start, end, float(f)));
+      const double r = std::fabs(double(v) - y[f]) / tol.at(f);
+      if (r > worst) worst = r, arg = f;
+    }
+    return worst;
+  }
+  constexpr uint32_t kChunk = 64;
+  double r[kChunk];
+  const float a = static_cast<float>(start);
+  const float len = static_cast<float>(end) - a;
+  for (uint32_t c0 = start + 1; c0 < end; c0 += kChunk) {
+    const uint32_t m = std::min(kChunk, end - c0);
+    const double* yc = y + c0;
+    const float* factor = tol.factor + c0;
+    const int32_t first = static_cast<int32_t>(c0);
+    for (uint32_t i = 0; i < m; ++i) {
+      const float v = eval_operands(ops, (static_cast<float>(first + static_cast<int32_t>(i)) - a) / len);
+      r[i] = std::fabs(double(v) - yc[i]) / (tol.base * double(factor[i]));
+    }
+    for (uint32_t i = 0; i < m; ++i)
+      if (r[i] > worst) worst = r[i], arg = c0 + i;
+  }
+  return worst;
+}
+
+}  // namespace
+
 void FitScratch::prepare(size_t frames) {
   if (prev.size() == frames) return;
   prev.assign(frames, CurveFit::kNone), next.assign(frames, CurveFit::kNone), is_key.assign(frames, 0);
@@ -78,9 +122,7 @@ void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double s
   }
 }
 
-void CurveFit::quantize_at(uint32_t f) {
-  w_.v[f] = dequantize(quantize(y_[f], step_), step_);
-}
+void CurveFit::quantize_at(uint32_t f) { w_.v[f] = key_value(y_[f], step_); }
 
 void CurveFit::measure_all() {
   heap_ = {};
@@ -94,44 +136,10 @@ void CurveFit::measure(uint32_t start, bool push) {
   const Key before{p, p != kNone ? w_.v[p] : 0.0f}, after{n, n != kNone ? w_.v[n] : 0.0f};
   const SegmentOperands ops = operands_between(p != kNone ? &before : nullptr, {start, w_.v[start]},
                                                {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
-  double worst = 0.0;
-  uint32_t arg = start + 1;
-  if (end - start <= kShortSegment) {
-    for (uint32_t f = start + 1; f < end; ++f) {
-      const float v = eval_operands(ops, segment_u(start, end, float(f)));
-      const double r = std::fabs(double(v) - y_[f]) / tol_.at(f);
-      if (r > worst) worst = r, arg = f;
-    }
-  } else {
-    worst_in(ops, start, end, worst, arg);
-  }
+  uint32_t arg = 0;
+  const double worst = worst_ratio(y_, tol_, ops, start, end, arg);
   w_.seg_ratio[start] = worst, w_.seg_arg[start] = arg;
   if (push && worst > 1.0) heap_.push({worst, start, end});
-}
-
-// The loop of measure() over a long segment, in chunks the compiler turns into vector
-// instructions: the same operations on every frame (segment_u with its constants hoisted), then
-// the first frame with the largest ratio. Frames are below 2^31, so converting them as signed
-// gives the same floats.
-void CurveFit::worst_in(const SegmentOperands& ops, uint32_t start, uint32_t end, double& worst,
-                        uint32_t& arg) const {
-  constexpr uint32_t kChunk = 64;
-  double r[kChunk];
-  const float a = static_cast<float>(start);
-  const float len = static_cast<float>(end) - a;
-  const double base = tol_.base;
-  for (uint32_t c0 = start + 1; c0 < end; c0 += kChunk) {
-    const uint32_t m = std::min(kChunk, end - c0);
-    const double* y = y_ + c0;
-    const float* factor = tol_.factor + c0;
-    const int32_t first = static_cast<int32_t>(c0);
-    for (uint32_t i = 0; i < m; ++i) {
-      const float v = eval_operands(ops, (static_cast<float>(first + static_cast<int32_t>(i)) - a) / len);
-      r[i] = std::fabs(double(v) - y[i]) / (base * double(factor[i]));
-    }
-    for (uint32_t i = 0; i < m; ++i)
-      if (r[i] > worst) worst = r[i], arg = c0 + i;
-  }
 }
 
 void CurveFit::link(uint32_t f, uint32_t a, uint32_t b) {
@@ -316,6 +324,7 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
     const auto [lo, hi] = std::minmax_element(scratch.y.begin(), scratch.y.end());
     lo_ = *lo, hi_ = *hi, have_extent_ = true;
   }
+  fitted_ = false;
   if (auto c = constant_channel(y, n, lo_, hi_, tol, step)) return *c;
   if (candidates_.empty()) {
     const std::vector<uint32_t> ends = end_keys(n);
@@ -347,8 +356,40 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
     }
   }
   keep_fewest();
+  fitted_ = true;
   const Candidate& b = candidates_.front();  // the first of a tie, as before any was dropped
   return channel_at(y, b.interp, b.tension, b.step, b.keys);
+}
+
+bool ChannelFitter::holds(Tolerance tol, double step, const std::vector<uint32_t>& changed, const double* y) const {
+  if (!fitted_) return false;
+  for (const Candidate& c : candidates_)
+    if (c.step != step || !segments_within(c, y, tol, changed)) return false;
+  return true;
+}
+
+// The segments CurveFit::resume re-measures, found by search in the key list instead of
+// through the per-frame links, with measure()'s arithmetic.
+bool ChannelFitter::segments_within(const Candidate& c, const double* y, Tolerance tol,
+                                    const std::vector<uint32_t>& changed) const {
+  const std::vector<uint32_t>& k = c.keys;
+  if (k.empty() || k.front() != 0) return false;  // every fit keeps the first frame
+  const float s = tension_to_s(c.tension);
+  size_t last = SIZE_MAX;
+  for (const uint32_t f : changed) {
+    size_t i = size_t(std::upper_bound(k.begin(), k.end(), f) - k.begin()) - 1;  // k[i] <= f
+    if (k[i] == f && i > 0) --i;  // a key's tolerance bounds the segment before it
+    if (i == last || i + 1 == k.size()) continue;
+    last = i;
+    const Key a{k[i], key_value(y[k[i]], c.step)}, b{k[i + 1], key_value(y[k[i + 1]], c.step)};
+    const Key before = i > 0 ? Key{k[i - 1], key_value(y[k[i - 1]], c.step)} : Key{};
+    const Key after = i + 2 < k.size() ? Key{k[i + 2], key_value(y[k[i + 2]], c.step)} : Key{};
+    const SegmentOperands ops = operands_between(i > 0 ? &before : nullptr, a, b, i + 2 < k.size() ? &after : nullptr,
+                                                 c.interp, s, opt_.rule);
+    uint32_t arg = 0;
+    if (worst_ratio(y, tol, ops, a.frame, b.frame, arg) > 1.0) return false;
+  }
+  return true;
 }
 
 void ChannelFitter::keep_fewest() {

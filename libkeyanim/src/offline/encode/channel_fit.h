@@ -104,8 +104,6 @@ class CurveFit {
   // Segment starting at key frame `start`: worst ratio |error| / tol over the frames inside
   // it; queued if over budget.
   void measure(uint32_t start, bool push = true);
-  static constexpr uint32_t kShortSegment = 8;  // shorter segments skip the vectorized loop
-  void worst_in(const SegmentOperands& ops, uint32_t start, uint32_t end, double& worst, uint32_t& arg) const;
   void measure_all();
   bool try_remove(uint32_t f);
 
@@ -153,6 +151,15 @@ class ChannelFitter {
   // tolerances, whose values changed only at `changed` frames since the last call (null:
   // anywhere); returns the candidate with the fewest keys.
   EncodedChannel fit(Tolerance tol, double step, const std::vector<uint32_t>* changed, FitScratch& scratch);
+  // True if fit() with these arguments would return what the last fit() returned: that was a
+  // candidate (not a constant channel, which tighter tolerances at the same step cannot make
+  // one), the step is the same, and every segment fit() would re-measure for the `changed`
+  // frames (sorted) is still within `tol`. The caller then keeps the channel it has: no key
+  // list to rebuild, nothing to requantize or compare. From the third round, a quarter (CMU
+  // 01_01) to nearly all (Bandai walk_normal_001) of the channels tightened in a round keep
+  // their keys; encoding takes 3.7% fewer instructions on 01_01 and 5.8% on that walk
+  // (callgrind, one thread), for the same bytes.
+  bool holds(Tolerance tol, double step, const std::vector<uint32_t>& changed, const double* y) const;
   // How many candidates the next fit refits (keep_fewest).
   size_t candidate_count() const { return candidates_.size(); }
 
@@ -174,8 +181,11 @@ class ChannelFitter {
     double step = 0.0;            // of the last fit
     std::vector<uint32_t> keys;   // key frames at the end of the last fit
   };
+  // Whether every segment of c's keys that holds one of `changed` is within `tol`.
+  bool segments_within(const Candidate& c, const double* y, Tolerance tol, const std::vector<uint32_t>& changed) const;
   ChannelFitOptions opt_;
   std::vector<Candidate> candidates_;
+  bool fitted_ = false;  // the last fit() returned candidates_.front()
   bool have_extent_ = false;
   double lo_ = 0.0, hi_ = 0.0;  // extent of the signal (it does not change between rounds)
 };

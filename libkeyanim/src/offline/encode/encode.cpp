@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -123,19 +124,22 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
     const EncodedChannel& last = job.enc.channels[c];
     const bool hold = round > 0 && round < kStepHoldRounds && last.frames.size() >= 2;
     const double step = budgets.step(c, kStepFraction, hold ? last.step : 0.0);
-    EncodedChannel fitted;
+    std::optional<EncodedChannel> fitted;  // none: the channel it has still holds
     switch (job.settings.key_mode) {
       case KeyMode::error:
         if (round > 0) budgets.changed_frames(c, s.changed);
-        fitted = fitters[c].fit(tol, step, round > 0 ? &s.changed : nullptr, s.fit);
+        if (round == 0 || !fitters[c].holds(tol, step, s.changed, s.fit.y.data()))
+          fitted = fitters[c].fit(tol, step, round > 0 ? &s.changed : nullptr, s.fit);
         break;
       case KeyMode::curvature:
         fitted = fit_channel_at_keys(s.fit.y, curvature_keys(s.fit.y), tol, step, options, s.fit);
         break;
       default: fitted = fit_channel_at_keys(s.fit.y, job.fixed_keys, tol, step, options, s.fit); break;
     }
-    if (round > 0) changed_ranges(job.enc.channels[c], fitted, m.frame_count, ranges[i]);
-    job.enc.channels[c] = std::move(fitted);
+    if (fitted) {
+      if (round > 0) changed_ranges(job.enc.channels[c], *fitted, m.frame_count, ranges[i]);
+      job.enc.channels[c] = std::move(*fitted);
+    }
     const size_t d = ++done;
     if (w == 0) report(job.settings, EncodeStage::fitting, d, refit.size());
   });
