@@ -111,6 +111,7 @@ void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double s
   link_keys(keys);  // quantized at the current step: a changed step requantizes every key
   if (step != previous_step || !changed) return measure_all();
   // Every other segment was within its (unchanged) tolerance when the last fit ended.
+  all_measured_ = false;  // the scratch holds other fits' ratios for them
   uint32_t last = kNone;  // changed frames are sorted: measure each segment once
   for (uint32_t f : *changed) {
     uint32_t s = f;
@@ -126,6 +127,7 @@ void CurveFit::quantize_at(uint32_t f) { w_.v[f] = key_value(y_[f], step_); }
 
 void CurveFit::measure_all() {
   heap_ = {};
+  all_measured_ = true;
   for (uint32_t f = first_; f != kNone && w_.next[f] != kNone; f = w_.next[f]) measure(f);
 }
 
@@ -164,10 +166,15 @@ void CurveFit::refine() {
     quantize_at(f);
     link(f, a, b);
     recent_.push_back(f);
-    if (w_.prev[a] != kNone) measure(w_.prev[a]);
+    if (w_.prev[a] != kNone) measure_neighbour(w_.prev[a]);
     measure(a), measure(f);
-    if (w_.next[b] != kNone) measure(b);
+    if (w_.next[b] != kNone) measure_neighbour(b);
   }
+}
+
+void CurveFit::measure_neighbour(uint32_t start) {
+  if (!neighbours_stand()) return measure(start);
+  if (w_.seg_ratio[start] > 1.0) heap_.push({w_.seg_ratio[start], start, w_.next[start]});  // as measure() would
 }
 
 void CurveFit::prune() {
@@ -204,7 +211,7 @@ bool CurveFit::try_remove(uint32_t f) {
   bool ok = true;
   for (uint32_t s : {p, a, b}) {
     if (!ok || s == kNone || w_.next[s] == kNone) continue;
-    measure(s, false);  // on success every ratio is <= 1: nothing for the heap
+    if (s == a || !neighbours_stand()) measure(s, false);  // on success every ratio is <= 1: nothing for the heap
     ok = w_.seg_ratio[s] <= 1.0;
   }
   if (ok) return true;

@@ -104,6 +104,15 @@ class CurveFit {
   // Segment starting at key frame `start`: worst ratio |error| / tol over the frames inside
   // it; queued if over budget.
   void measure(uint32_t start, bool push = true);
+  // A linear segment depends on its two keys only: a key inserted or removed between a and b
+  // leaves [prev(a), a] and [b, next(b)] as they were, and where every segment's ratio is
+  // current (since measure_all) the stored one stands for a re-measurement. The same keys
+  // (every corpus file's bytes as before, at 0.05% and 0.5%, and with linear forced), for
+  // 3.6% fewer encoding instructions on CMU 01_01 and 2.4% on Bandai walk_normal_001
+  // (callgrind, one thread): the first fit tries linear on every channel.
+  bool neighbours_stand() const { return interp_ == Interpolation::linear && all_measured_; }
+  // measure() of a segment next to a change.
+  void measure_neighbour(uint32_t start);
   void measure_all();
   bool try_remove(uint32_t f);
 
@@ -119,6 +128,7 @@ class CurveFit {
   std::priority_queue<Entry> heap_;  // lazily invalidated: checked against the list when popped
   std::vector<uint32_t> recent_;     // keys inserted since the last prune
   bool prune_all_ = true;
+  bool all_measured_ = false;  // every segment's seg_ratio and seg_arg are this fit's
 };
 
 struct ChannelFitOptions {
