@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 namespace keyanim::offline {
@@ -58,6 +59,25 @@ double worst_ratio(const double* y, const Tolerance& tol, const SegmentOperands&
   return worst;
 }
 
+// The segments a refit re-measures after its tolerances tightened at `changed` frames
+// (sorted): visit(i) for each segment [keys[i], keys[i + 1]] that holds one of them, or that
+// ends at one (a key's tolerance bounds the fit of the segment before it), once each, in
+// order, while visit returns true. Returns false if a visit did.
+template <class Visit>
+bool for_each_changed_segment(const std::vector<uint32_t>& keys, const std::vector<uint32_t>& changed, Visit visit) {
+  size_t last = SIZE_MAX;
+  for (const uint32_t f : changed) {
+    size_t i = size_t(std::upper_bound(keys.begin(), keys.end(), f) - keys.begin());  // keys[i - 1] <= f
+    if (i == 0) continue;  // before the first key: no segment
+    --i;
+    if (keys[i] == f && i > 0) --i;
+    if (i == last || i + 1 == keys.size()) continue;
+    last = i;
+    if (!visit(i)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void FitScratch::prepare(size_t frames) {
@@ -112,15 +132,10 @@ void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double s
   if (step != previous_step || !changed) return measure_all();
   // Every other segment was within its (unchanged) tolerance when the last fit ended.
   all_measured_ = false;  // the scratch holds other fits' ratios for them
-  uint32_t last = kNone;  // changed frames are sorted: measure each segment once
-  for (uint32_t f : *changed) {
-    uint32_t s = f;
-    while (s != 0 && !w_.is_key[s]) --s;
-    if (s == f && w_.is_key[f] && f != first_) s = w_.prev[f];  // a key's tolerance bounds its neighbours' fits
-    if (s == last || w_.next[s] == kNone) continue;
-    measure(s);
-    last = s;
-  }
+  for_each_changed_segment(keys, *changed, [&](size_t i) {
+    measure(keys[i]);
+    return true;
+  });
 }
 
 void CurveFit::quantize_at(uint32_t f) { w_.v[f] = key_value(y_[f], step_); }
@@ -375,28 +390,20 @@ bool ChannelFitter::holds(Tolerance tol, double step, const std::vector<uint32_t
   return true;
 }
 
-// The segments CurveFit::resume re-measures, found by search in the key list instead of
-// through the per-frame links, with measure()'s arithmetic.
+// The segments CurveFit::resume re-measures, with measure()'s arithmetic.
 bool ChannelFitter::segments_within(const Candidate& c, const double* y, Tolerance tol,
                                     const std::vector<uint32_t>& changed) const {
   const std::vector<uint32_t>& k = c.keys;
-  if (k.empty() || k.front() != 0) return false;  // every fit keeps the first frame
   const float s = tension_to_s(c.tension);
-  size_t last = SIZE_MAX;
-  for (const uint32_t f : changed) {
-    size_t i = size_t(std::upper_bound(k.begin(), k.end(), f) - k.begin()) - 1;  // k[i] <= f
-    if (k[i] == f && i > 0) --i;  // a key's tolerance bounds the segment before it
-    if (i == last || i + 1 == k.size()) continue;
-    last = i;
+  return for_each_changed_segment(k, changed, [&](size_t i) {
     const Key a{k[i], key_value(y[k[i]], c.step)}, b{k[i + 1], key_value(y[k[i + 1]], c.step)};
     const Key before = i > 0 ? Key{k[i - 1], key_value(y[k[i - 1]], c.step)} : Key{};
     const Key after = i + 2 < k.size() ? Key{k[i + 2], key_value(y[k[i + 2]], c.step)} : Key{};
     const SegmentOperands ops = operands_between(i > 0 ? &before : nullptr, a, b, i + 2 < k.size() ? &after : nullptr,
                                                  c.interp, s, opt_.rule);
     uint32_t arg = 0;
-    if (worst_ratio(y, tol, ops, a.frame, b.frame, arg) > 1.0) return false;
-  }
-  return true;
+    return worst_ratio(y, tol, ops, a.frame, b.frame, arg) <= 1.0;
+  });
 }
 
 void ChannelFitter::keep_fewest() {
