@@ -64,12 +64,22 @@ constexpr uint32_t kVerifyWindow = 128;
 // Windows per batch of verification (verify_and_tighten): 8,192 frames.
 constexpr size_t kVerifyBatch = 64;
 
-// Freed memory goes back to the system: glibc keeps the scattered pages of many small vectors
-// (each channel's keys, reallocated every round), and the phases after the rounds would add
-// their peak on top (memory is a target: bench_codec's peak_rss_over_bvh_bytes).
-void release_free_memory() {
+// Freed memory goes back to the system on long clips: glibc keeps the scattered pages of many
+// small vectors (each channel's keys, reallocated every round), and the phases after the
+// rounds would add their peak on top (memory is a target: bench_codec's
+// peak_rss_over_bvh_bytes; `keyanim encode` on 11,008 frames peaks at 25.5 MB with the trim,
+// 33.1 MB without). On short clips there is little to return and returning it costs more than
+// it saves: the pages come back as faults in the phases after (writing, or the next clip's
+// encode). Trimming only from 2^19 values (4 MB of motion; CMU 01_01 has 264,192): encode and
+// write_kanim on one thread, median CPU time of 15 in one process, Bandai walk_normal_001 15.1
+// -> 13.3 ms, run_normal_001 2.8 -> 2.2 ms, CMU 01_01 229 -> 203 ms, for 1.5 MB more peak
+// memory on 01_01 (12.0 -> 13.5 MB).
+constexpr size_t kTrimFromValues = size_t(1) << 19;
+void release_free_memory(const Motion& m) {
 #if defined(__GLIBC__)
-  malloc_trim(0);
+  if (m.values.size() >= kTrimFromValues) malloc_trim(0);
+#else
+  (void)m;
 #endif
 }
 
@@ -286,7 +296,7 @@ EncodeResult encode(const Motion& m, const EncodeSettings& settings) {
   if (settings.key_mode == KeyMode::uniform) job.fixed_keys = uniform_keys(m.frame_count, settings.uniform_interval);
   if (settings.key_mode == KeyMode::manual) job.fixed_keys = manual_keys(settings.manual_frames, m.frame_count);
   const uint32_t rounds = fit_within_tolerance(job);
-  release_free_memory();  // the rounds' budgets and fits, before the measurement takes its own
+  release_free_memory(m);  // the rounds' budgets and fits, before the measurement takes its own
 
   // A clip the container cannot store (a frame time of 0 with several frames, a value whose
   // quantized integer overflows in the fixed-key modes) is an error, not a result.
@@ -304,7 +314,7 @@ EncodeResult encode(const Motion& m, const EncodeSettings& settings) {
   out.total_keys = 0;
   for (const EncodedChannel& ch : enc.channels) out.total_keys += ch.frames.size();
   enc.notes = encoder_notes(settings, tol_units, m.skeleton, out.error, out.iterations);
-  release_free_memory();  // the measurement's clip, before the caller writes the file
+  release_free_memory(m);  // the measurement's clip, before the caller writes the file
   return out;
 }
 
