@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <new>
+#include <span>
 
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/metrics.h"
@@ -125,8 +126,8 @@ void select_nodes(const Skeleton& s, const FrameMarks& marks, uint8_t check, uin
 // w.error[k] (the formula of measure_error, so that what passes here passes the final report;
 // the square is compared first against a bound safely inside the tolerance: sqrt is correctly
 // rounded).
-void add_errors(const Skeleton& s, double tol, double shell, const std::vector<Vec3>& original,
-                const std::vector<Vec3>& decoded, size_t k, VerifyScratch& w) {
+void add_errors(const Skeleton& s, double tol, double shell, const Vec3* original, const Vec3* decoded, size_t k,
+                VerifyScratch& w) {
   const double surely_within = tol * tol * (1.0 - 1e-9);
   for (size_t d = 0; d < s.joints.size(); ++d) {
     if (!w.measure[k][d]) continue;
@@ -145,57 +146,103 @@ void add_errors(const Skeleton& s, double tol, double shell, const std::vector<V
   }
 }
 
+// Four rows at a time: `rows` posed under readings[0] (and the add reading when both are
+// measured) into w.points (w.points_add), for the nodes w.pose marks.
+void pose_rows(const Skeleton& s, const std::array<const double*, 4>& rows, double shell,
+               std::span<const PositionReading> readings, VerifyScratch& w) {
+  measured_points(s, rows, shell, readings[0], w.points, w.pose.data(), readings.size() > 1 ? &w.points_add : nullptr);
+}
+
 }  // namespace
+
+namespace {
+thread_local std::vector<Vec3> t_spare_points;  // the storage of the last OriginalPoints on this thread
+}  // namespace
+
+OriginalPoints::OriginalPoints(const Motion& m, double shell, size_t budget, unsigned threads) : budget_(budget) {
+  const std::span<const PositionReading> readings = measured_readings(m.skeleton);
+  const size_t per_frame = size_t(kPointsPerNode) * m.skeleton.joints.size();
+  if (m.frame_count == 0 || per_frame == 0 || size_t(m.frame_count) * per_frame * sizeof(Vec3) * readings.size() > budget)
+    return;
+  points_ = std::move(t_spare_points);
+  points_.resize(readings.size() * size_t(m.frame_count) * per_frame);
+  per_frame_ = per_frame, frames_ = m.frame_count;
+  const size_t n_ch = m.channel_count();
+  constexpr uint32_t kGroups = 64;  // frames per job: 16 groups of four
+  parallel_for((size_t(m.frame_count) + kGroups - 1) / kGroups, threads, [&](size_t job, unsigned) {
+    VerifyScratch w;
+    w.pose.assign(m.skeleton.joints.size(), 1);
+    const uint32_t end = uint32_t(std::min<size_t>(m.frame_count, (job + 1) * kGroups));
+    for (uint32_t f = uint32_t(job * kGroups); f < end; f += 4) {
+      std::array<const double*, 4> rows;
+      for (uint32_t k = 0; k < 4; ++k) rows[k] = m.values.data() + size_t(std::min(f + k, end - 1)) * n_ch;
+      pose_rows(m.skeleton, rows, shell, readings, w);
+      for (uint32_t k = 0; k < 4 && f + k < end; ++k)
+        for (size_t r = 0; r < readings.size(); ++r) {
+          const std::vector<Vec3>& from = r == 0 ? w.points[k] : w.points_add[k];
+          std::copy(from.begin(), from.end(), points_.begin() + ptrdiff_t((r * frames_ + f + k) * per_frame));
+        }
+    }
+  });
+}
+
+OriginalPoints::~OriginalPoints() {
+  if (points_.capacity() * sizeof(Vec3) <= budget_ && points_.capacity() > t_spare_points.capacity())
+    t_spare_points = std::move(points_);
+}
 
 void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
                    double shell, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
-                   VerifyScratch& w) {
+                   VerifyScratch& w, const OriginalPoints* originals) {
   uint8_t* check = marks.check();
   const auto& joints = m.skeleton.joints;
   const size_t n_ch = channels.size(), nodes = joints.size();
   const std::span<const PositionReading> readings = measured_readings(m.skeleton);
+  const bool held = originals && !originals->empty();
   w.cursors.resize(n_ch);
   for (size_t c = 0; c < n_ch; ++c) w.cursors[c] = ChannelCursor(channels[c], rule);
   w.frames.clear();
   for (uint32_t f = first; f < first + count; ++f)
     if (check[f]) w.frames.push_back(f);
-  for (size_t k = 0; k < 2; ++k) {
+  for (size_t k = 0; k < 4; ++k) {
     w.row[k].resize(n_ch), w.measure[k].resize(nodes), w.error[k].resize(nodes), w.shell_over[k].resize(nodes);
   }
   w.pose.resize(nodes);
-  // Two frames at a time: one FK poses both frames' original and decoded rows (four lanes).
-  for (size_t i = 0; i < w.frames.size(); i += 2) {
-    const size_t pair = std::min<size_t>(2, w.frames.size() - i);
+  // Frames in groups: one FK pass of four rows poses two frames' original and decoded rows, or
+  // four frames' decoded rows when the original's points are held. A group short of frames
+  // repeats its last rows (posed, not measured).
+  const size_t group = held ? 4 : 2;
+  for (size_t i = 0; i < w.frames.size(); i += group) {
+    const size_t size = std::min(group, w.frames.size() - i);
     std::fill(w.pose.begin(), w.pose.end(), 0);
-    for (size_t k = 0; k < pair; ++k) select_nodes(m.skeleton, marks, check[w.frames[i + k]], w.frames[i + k], k, w);
+    for (size_t k = 0; k < size; ++k) select_nodes(m.skeleton, marks, check[w.frames[i + k]], w.frames[i + k], k, w);
     for (size_t j = nodes; j-- > 0;) {  // and their ancestors
       const int32_t p = joints[j].parent;
       if (w.pose[j] && p >= 0 && size_t(p) < j) w.pose[size_t(p)] = 1;
     }
-    const double* original[2];
-    for (size_t k = 0; k < pair; ++k) {
+    for (size_t k = 0; k < size; ++k) {
       const uint32_t f = w.frames[i + k];
       for (size_t j = 0; j < nodes; ++j) {
         if (!w.pose[j]) continue;
         for (size_t c = joints[j].first_channel; c < joints[j].first_channel + joints[j].channels.size(); ++c)
           w.row[k][c] = w.cursors[c].at(f);
       }
-      original[k] = m.values.data() + size_t(f) * n_ch;
     }
-    // Under each reading (replace, then add: one FK pass poses both).
-    const bool both = readings.size() > 1;
-    if (pair == 2) {
-      measured_points(m.skeleton, {original[0], w.row[0].data(), original[1], w.row[1].data()}, shell, readings[0],
-                      w.points, w.pose.data(), both ? &w.points_add : nullptr);
-    } else {
-      measured_points(m.skeleton, original[0], w.row[0].data(), shell, readings[0], w.points[0], w.points[1],
-                      w.pose.data(), both ? &w.points_add[0] : nullptr, both ? &w.points_add[1] : nullptr);
+    auto original = [&](size_t k) { return m.values.data() + size_t(w.frames[i + std::min(k, size - 1)]) * n_ch; };
+    auto decoded = [&](size_t k) -> const double* { return w.row[std::min(k, size - 1)].data(); };
+    if (held)
+      pose_rows(m.skeleton, {decoded(0), decoded(1), decoded(2), decoded(3)}, shell, readings, w);
+    else
+      pose_rows(m.skeleton, {original(0), decoded(0), original(1), decoded(1)}, shell, readings, w);
+    for (size_t r = 0; r < readings.size(); ++r) {
+      const auto& points = r == 0 ? w.points : w.points_add;
+      for (size_t k = 0; k < size; ++k) {
+        const Vec3* a = held ? originals->at(w.frames[i + k], r) : points[2 * k].data();
+        const Vec3* b = held ? points[k].data() : points[2 * k + 1].data();
+        add_errors(m.skeleton, tol, shell, a, b, k, w);
+      }
     }
-    for (const auto* points : {&w.points, &w.points_add}) {
-      for (size_t k = 0; k < pair; ++k) add_errors(m.skeleton, tol, shell, (*points)[2 * k], (*points)[2 * k + 1], k, w);
-      if (!both) break;
-    }
-    for (size_t k = 0; k < pair; ++k) {
+    for (size_t k = 0; k < size; ++k) {
       const uint32_t f = w.frames[i + k];
       bool frame_over = false;
       for (size_t d = 0; d < nodes; ++d) {

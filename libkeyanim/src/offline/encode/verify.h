@@ -100,17 +100,46 @@ class FrameMarks {
   std::vector<uint64_t> over_;   // per node, a bit per frame: over when last measured
 };
 
-// Working memory of verify_window, one per thread. Frames are verified two at a time (four
-// rows posed together: each frame's original and decoded), index k = 0, 1 of the pair.
+// The original's measured points (measured_points) at every frame, under each of
+// measured_readings, posed once for every round instead of with each frame verified: one FK
+// pass of four rows then verifies four frames instead of two (an original and a decoded row
+// each). Held only where they take at most `budget` bytes (96 per node and frame and reading);
+// otherwise empty, and verify_window poses the original with each frame as before. The same
+// points either way, bit for bit (measured_points of four rows is that of each row alone).
+// Their storage is kept for the next clip encoded on the same thread (up to `budget` bytes):
+// a fresh megabyte per clip came back as page faults every time (glibc returns the top of its
+// heap when it is freed), which made Bandai bow_feminine_001's encode 9.5 -> 11.5 ms instead
+// of 9.5 -> 9.0 (one thread, median of 15 in one process).
+class OriginalPoints {
+ public:
+  OriginalPoints() = default;
+  OriginalPoints(const Motion& original, double shell, size_t budget, unsigned threads);
+  ~OriginalPoints();
+  OriginalPoints(const OriginalPoints&) = delete;
+  OriginalPoints& operator=(const OriginalPoints&) = delete;
+  bool empty() const noexcept { return per_frame_ == 0; }
+  // Frame f's points under measured_readings(...)[reading].
+  const Vec3* at(uint32_t f, size_t reading) const noexcept {
+    return points_.data() + (reading * frames_ + f) * per_frame_;
+  }
+
+ private:
+  size_t per_frame_ = 0, frames_ = 0, budget_ = 0;
+  std::vector<Vec3> points_;  // reading-major, then frame-major
+};
+
+// Working memory of verify_window, one per thread. Frames are verified in groups (k = 0 .. 3
+// within one): four rows posed together, each frame's original and decoded rows (two frames),
+// or with OriginalPoints four frames' decoded rows.
 struct VerifyScratch {
   std::vector<ChannelCursor> cursors;
   std::vector<uint32_t> frames;                // of the window, to verify
-  std::array<std::vector<double>, 2> row;      // decoded
-  std::array<std::vector<uint8_t>, 2> measure; // per node: its error is measured
-  std::vector<uint8_t> pose;                   // per node: posed (for either frame)
-  std::array<std::vector<double>, 2> error;    // per node: the largest distance over the readings
-  std::array<std::vector<uint8_t>, 2> shell_over;  // per node: a shell point is over
-  std::array<std::vector<Vec3>, 4> points;     // original, decoded of frame 0; of frame 1
+  std::array<std::vector<double>, 4> row;      // decoded
+  std::array<std::vector<uint8_t>, 4> measure; // per node: its error is measured
+  std::vector<uint8_t> pose;                   // per node: posed (for any frame of the group)
+  std::array<std::vector<double>, 4> error;    // per node: the largest distance over the readings
+  std::array<std::vector<uint8_t>, 4> shell_over;  // per node: a shell point is over
+  std::array<std::vector<Vec3>, 4> points;     // of the four rows posed
   std::array<std::vector<Vec3>, 4> points_add; // the same under the add reading (when measured)
 };
 
@@ -123,9 +152,10 @@ struct VerifyScratch {
 // kAll); every other node has not moved since it was last found within the tolerance, so the
 // list is the one measuring every node would give. Frames with a node over stay marked kOver;
 // the others are unmarked. `first` is a multiple of 64 where windows run concurrently.
+// `originals`: the original's points, if held (the same result, in fewer instructions).
 void verify_window(const Motion& original, const std::vector<EncodedChannel>& channels, TangentRule rule,
                    double tolerance, double shell, uint32_t first, uint32_t count, FrameMarks& marks,
-                   std::vector<OverNode>& over, VerifyScratch& scratch);
+                   std::vector<OverNode>& over, VerifyScratch& scratch, const OriginalPoints* originals = nullptr);
 
 // The error report of `clip` (valid: validate_encoded_clip) against `original`, on the clip a
 // decoder loads (to_clip) sampled by Clip::sample at every frame: measure_error's numbers,
