@@ -65,8 +65,10 @@ constexpr uint32_t kVerifyWindow = 128;
 constexpr size_t kVerifyBatch = 64;
 // The original's points are posed once for all rounds where they take at most this (verify.h:
 // OriginalPoints; 96 bytes per node, frame and reading): every Bandai clip of the corpus but
-// its 1,901-frame one, and CMU clips up to about a thousand frames. Small next to the
-// process's own footprint; a long clip, whose memory is a target, poses them with each frame.
+// its 1,901-frame one, and 12 of its 17 CMU 120 fps clips (38 nodes, one reading: up to 2,300
+// frames). Small next to the process's own footprint; a long clip, whose memory is a target,
+// poses them with each frame. (16 MiB would take CMU 01_01 too: 5.9% fewer instructions, but
+// its peak 13.5 -> 23.3 MB.)
 // The same bytes on every corpus file; `keyanim encode -j 1` (callgrind): Bandai walk_normal_001
 // 131.8 M -> 125.9 M instructions, bow_feminine_001 109.1 M -> 103.2 M, dash_normal_001 (20
 // frames) 23.1 M -> 22.6 M; CPU time of encode 10.9 -> 10.5 ms, 9.5 -> 9.0 ms (best of three
