@@ -195,6 +195,16 @@ TEST_SUITE("channel_fit") {
     CHECK(c->q == std::vector<int64_t>{3});
     y[20] = 3.5;
     CHECK_FALSE(constant_channel(y.data(), 50, 3.0, 3.5, tol, 0.1).has_value());
+    // Spread just under twice the tolerance: the midpoint is within at both extremes; just
+    // over: no value is.
+    for (const double spread : {0.19, 0.2002}) {
+      CAPTURE(spread);
+      y.assign(50, 1.0);
+      y[30] = 1.0 + spread;
+      c = constant_channel(y.data(), 50, 1.0, 1.0 + spread, tol, 0.001);
+      CHECK(c.has_value() == (spread < 0.2));
+      if (c) CHECK(std::fabs(dequantize(c->q[0], c->step) - (1.0 + 0.5 * spread)) < 0.001);
+    }
   }
 
   TEST_CASE("fixed keys are kept as given") {

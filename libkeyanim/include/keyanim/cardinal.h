@@ -84,27 +84,42 @@ struct SegmentOperands {
   bool linear = false;
 };
 
-inline SegmentOperands segment_operands(const uint32_t* frames, const float* values, uint32_t n, uint32_t j,
-                                        Interpolation interp, float s, TangentRule rule) noexcept {
+// A key of a segment's window, and whether the channel has it (a missing one is an end point,
+// duplicated: its value is the segment's nearer key's, and its tangent scale is 1).
+struct WindowKey {
+  uint32_t frame = 0;
+  float value = 0.0f;
+};
+
+// Operands of the segment from key k0 to key k1, with the key before k0 (`before`) and after
+// k1 (`after`) where the channel has them (null at its ends).
+inline SegmentOperands window_operands(const WindowKey* before, WindowKey k0, WindowKey k1, const WindowKey* after,
+                                       Interpolation interp, float s, TangentRule rule) noexcept {
   SegmentOperands r;
-  const float p0 = values[j];
-  const float p1 = values[j + 1];
   r.linear = interp == Interpolation::linear;
   if (r.linear) {
-    r.o = {p0, p1 - p0, 0.0f, 0.0f};
+    r.o = {k0.value, k1.value - k0.value, 0.0f, 0.0f};
     return r;
   }
-  const float pm = values[j > 0 ? j - 1 : 0];
-  const float p2 = values[j + 2 < n ? j + 2 : n - 1];
+  const float pm = before ? before->value : k0.value;
+  const float p2 = after ? after->value : k1.value;
   float a0 = 1.0f;
   float a1 = 1.0f;
   if (rule == TangentRule::step_adjusted) {
-    const float len = static_cast<float>(frames[j + 1] - frames[j]);
-    if (j > 0) a0 = tangent_scale(len, static_cast<float>(frames[j] - frames[j - 1]));
-    if (j + 2 < n) a1 = tangent_scale(len, static_cast<float>(frames[j + 2] - frames[j + 1]));
+    const float len = static_cast<float>(k1.frame - k0.frame);
+    if (before) a0 = tangent_scale(len, static_cast<float>(k0.frame - before->frame));
+    if (after) a1 = tangent_scale(len, static_cast<float>(after->frame - k1.frame));
   }
-  r.o = cardinal_operands(pm, p0, p1, p2, s, a0, a1);
+  r.o = cardinal_operands(pm, k0.value, k1.value, p2, s, a0, a1);
   return r;
+}
+
+inline SegmentOperands segment_operands(const uint32_t* frames, const float* values, uint32_t n, uint32_t j,
+                                        Interpolation interp, float s, TangentRule rule) noexcept {
+  const WindowKey before{j > 0 ? frames[j - 1] : 0u, j > 0 ? values[j - 1] : 0.0f};
+  const WindowKey after{j + 2 < n ? frames[j + 2] : 0u, j + 2 < n ? values[j + 2] : 0.0f};
+  return window_operands(j > 0 ? &before : nullptr, {frames[j], values[j]}, {frames[j + 1], values[j + 1]},
+                         j + 2 < n ? &after : nullptr, interp, s, rule);
 }
 
 // The segment's value at local parameter u in [0, 1].

@@ -22,26 +22,8 @@ struct Tolerance {
 // The stored integer of a value: round half away from zero of y / step (std::llround).
 int64_t quantize(double y, double step) noexcept;
 
-// A key as the segment arithmetic sees it.
-struct Key {
-  uint32_t frame = 0;
-  float value = 0.0f;
-};
-
-// Operands of the segment from key a to key b, given the key before a and the key after b when
-// the channel has them (null at its ends): segment_operands on those (up to) four keys, which
-// duplicates end points exactly as it does over the whole list.
-inline SegmentOperands operands_between(const Key* before, Key a, Key b, const Key* after, Interpolation interp,
-                                        float s, TangentRule rule) noexcept {
-  uint32_t frames[4];
-  float values[4];
-  uint32_t n = 0, j = 0;
-  if (before) frames[n] = before->frame, values[n++] = before->value, j = 1;
-  frames[n] = a.frame, values[n++] = a.value;
-  frames[n] = b.frame, values[n++] = b.value;
-  if (after) frames[n] = after->frame, values[n++] = after->value;
-  return segment_operands(frames, values, n, j, interp, s, rule);
-}
+// A key as the segment arithmetic sees it (window_operands takes the four around a segment).
+using Key = WindowKey;
 
 // The per-frame working arrays of a fit, reused from channel to channel (one per thread): what
 // a channel keeps between the encoder's rounds is then its keys, not arrays over its frames.

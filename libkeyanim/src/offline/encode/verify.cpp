@@ -34,7 +34,7 @@ void ChannelCursor::prepare() {
   const EncodedChannel& ch = *ch_;
   const size_t j = j_, n = ch.frames.size();
   const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
-  ops_ = operands_between(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
+  ops_ = window_operands(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
                           ch.interp, tension_to_s(ch.tension), rule_);
   prepared_ = j;
 }
