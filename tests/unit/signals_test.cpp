@@ -82,6 +82,26 @@ TEST_SUITE("signals") {
     CHECK(y[3] == doctest::Approx(179.0));
   }
 
+  TEST_CASE("signals held for the rounds are channel_signal's, held or not") {
+    // A motion whose angle wraps and whose two channels differ at every frame: a held copy
+    // read at the wrong column or frame, or not unwrapped, gives other values.
+    Motion m = two_nodes(200);
+    for (uint32_t f = 0; f < 200; ++f) m.values[f * 2] = 0.5 * f, m.values[f * 2 + 1] = std::fmod(7.0 * f, 360.0) - 180.0;
+    const ChannelLayout layout = channel_layout(m.skeleton);
+    for (const size_t budget : {size_t(1) << 20, size_t(100)}) {  // held; over the budget: read again
+      CAPTURE(budget);
+      for (int clip = 0; clip < 2; ++clip) {  // the second takes the first one's storage
+        const Signals signals(m, layout, budget, 2);
+        for (uint32_t c = 0; c < 2; ++c) {
+          std::vector<double> want, got;
+          channel_signal(m, layout, c, want);
+          signals.get(m, layout, c, got);
+          CHECK(got == want);
+        }
+      }
+    }
+  }
+
   TEST_CASE("unwrapping takes the shorter way at exactly 180 degrees as round() does") {
     std::vector<double> y{0.0, 180.0, 359.0, -1.0};
     unwrap_degrees(y);

@@ -74,6 +74,10 @@ constexpr size_t kVerifyBatch = 64;
 // frames) 23.1 M -> 22.6 M; CPU time of encode 10.9 -> 10.5 ms, 9.5 -> 9.0 ms (best of three
 // medians of 11, one process).
 constexpr size_t kOriginalPointsBudget = size_t(8) << 20;
+// Every channel's signal is made once for all rounds where it takes at most this (signals.h:
+// Signals, 8 bytes per value): every corpus clip, up to 1M values (CMU 01_01 has 264,192);
+// the rounds read the motion's columns again on longer ones, whose memory is a target.
+constexpr size_t kSignalsBudget = size_t(8) << 20;
 
 // Freed memory goes back to the system on long clips: glibc keeps the scattered pages of many
 // small vectors (each channel's keys, reallocated every round), and the phases after the
@@ -124,7 +128,7 @@ struct Job {
 // Fits the channels whose budgets changed (all of them in round 0) and marks the frames whose
 // decoded values may have changed.
 void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<ChannelFitter>& fitters,
-                  FrameMarks& marks) {
+                  FrameMarks& marks, const Signals& signals) {
   const Motion& m = job.m;
   const std::vector<uint32_t> refit = budgets.take_dirty();
   const ChannelFitOptions options = fit_options(job.settings);
@@ -139,7 +143,7 @@ void fit_channels(const Job& job, uint32_t round, Budgets& budgets, std::vector<
   parallel_for(refit.size(), job.threads, [&](size_t i, unsigned w) {
     const uint32_t c = refit[i];
     Worker& s = workers[w];
-    channel_signal(m, job.layout, c, s.fit.y);
+    signals.get(m, job.layout, c, s.fit.y);
     const Tolerance tol = budgets.tolerance(c);
     // A channel's step is held (Budgets::step) in the rounds before kStepHoldRounds.
     const EncodedChannel& last = job.enc.channels[c];
@@ -227,11 +231,12 @@ uint32_t fit_within_tolerance(const Job& job) {
   std::vector<ChannelFitter> fitters(m.channel_count(), ChannelFitter(fit_options(job.settings)));
   FrameMarks marks(m.frame_count, m.skeleton.joints.size());
   marks.mark_all();
-  const OriginalPoints originals = job.settings.key_mode == KeyMode::error
-                                       ? OriginalPoints(m, job.shell, kOriginalPointsBudget, job.threads)
-                                       : OriginalPoints();
+  const bool rounds = job.settings.key_mode == KeyMode::error;
+  const OriginalPoints originals = rounds ? OriginalPoints(m, job.shell, kOriginalPointsBudget, job.threads)
+                                          : OriginalPoints();
+  const Signals signals = rounds ? Signals(m, job.layout, kSignalsBudget, job.threads) : Signals();
   for (uint32_t round = 0;; ++round) {
-    fit_channels(job, round, budgets, fitters, marks);
+    fit_channels(job, round, budgets, fitters, marks, signals);
     if (job.settings.key_mode != KeyMode::error || m.frame_count == 0) return round + 1;
     if (!verify_and_tighten(job, round, budgets, marks, originals)) return round + 1;
     if (round + 1 >= kMaxRounds)

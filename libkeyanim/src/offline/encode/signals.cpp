@@ -7,6 +7,7 @@
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/number_text.h"
+#include "offline/encode/spare.h"
 #include "offline/parallel.h"
 
 namespace keyanim::offline {
@@ -107,6 +108,27 @@ void channel_signal(const Motion& m, const ChannelLayout& layout, uint32_t c, st
   out.resize(m.frame_count);
   for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = m.values[size_t(f) * stride + c];
   if (layout.rotation[c]) unwrap_degrees(out);
+}
+
+Signals::Signals(const Motion& m, const ChannelLayout& layout, size_t budget, unsigned threads)
+    : frames_(m.frame_count), budget_(budget) {
+  const size_t channels = layout.node.size();
+  if (channels == 0 || frames_ == 0 || size_t(frames_) * channels * sizeof(double) > budget) return;
+  values_ = take_spare<double>();
+  values_.resize(size_t(frames_) * channels);
+  parallel_for(channels, threads, [&](size_t c, unsigned) {
+    thread_local std::vector<double> column;
+    channel_signal(m, layout, uint32_t(c), column);
+    std::copy(column.begin(), column.end(), values_.begin() + ptrdiff_t(c * frames_));
+  });
+}
+
+Signals::~Signals() { give_spare(std::move(values_), budget_); }
+
+void Signals::get(const Motion& m, const ChannelLayout& layout, uint32_t c, std::vector<double>& out) const {
+  if (values_.empty()) return channel_signal(m, layout, c, out);
+  const double* column = values_.data() + size_t(c) * frames_;
+  out.assign(column, column + frames_);
 }
 
 void unwrap_degrees(std::vector<double>& y) {

@@ -26,4 +26,23 @@ ChannelLayout channel_layout(const Skeleton& skeleton);
 // keeps no copy of them.
 void channel_signal(const Motion& motion, const ChannelLayout& layout, uint32_t c, std::vector<double>& out);
 
+// Every channel's signal, made once for all the encoder's rounds where they take at most
+// `budget` bytes (8 per value: one more copy of the motion); otherwise none are held and each
+// round reads the columns again. Storage goes to the next clip encoded on the thread (spare.h).
+class Signals {
+ public:
+  Signals() = default;
+  Signals(const Motion& motion, const ChannelLayout& layout, size_t budget, unsigned threads);
+  ~Signals();
+  Signals(const Signals&) = delete;
+  Signals& operator=(const Signals&) = delete;
+  // channel_signal(motion, layout, c, out), from the held copy when there is one.
+  void get(const Motion& motion, const ChannelLayout& layout, uint32_t c, std::vector<double>& out) const;
+
+ private:
+  uint32_t frames_ = 0;
+  size_t budget_ = 0;
+  std::vector<double> values_;  // channel-major; empty: none held
+};
+
 }  // namespace keyanim::offline

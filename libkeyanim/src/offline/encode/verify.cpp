@@ -8,6 +8,7 @@
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/metrics.h"
 #include "offline/encode/channel_fit.h"
+#include "offline/encode/spare.h"
 #include "offline/parallel.h"
 
 namespace keyanim::offline {
@@ -155,16 +156,12 @@ void pose_rows(const Skeleton& s, const std::array<const double*, 4>& rows, doub
 
 }  // namespace
 
-namespace {
-thread_local std::vector<Vec3> t_spare_points;  // the storage of the last OriginalPoints on this thread
-}  // namespace
-
 OriginalPoints::OriginalPoints(const Motion& m, double shell, size_t budget, unsigned threads) : budget_(budget) {
   const std::span<const PositionReading> readings = measured_readings(m.skeleton);
   const size_t per_frame = size_t(kPointsPerNode) * m.skeleton.joints.size();
   if (m.frame_count == 0 || per_frame == 0 || size_t(m.frame_count) * per_frame * sizeof(Vec3) * readings.size() > budget)
     return;
-  points_ = std::move(t_spare_points);
+  points_ = take_spare<Vec3>();
   points_.resize(readings.size() * size_t(m.frame_count) * per_frame);
   per_frame_ = per_frame, frames_ = m.frame_count;
   const size_t n_ch = m.channel_count();
@@ -186,10 +183,7 @@ OriginalPoints::OriginalPoints(const Motion& m, double shell, size_t budget, uns
   });
 }
 
-OriginalPoints::~OriginalPoints() {
-  if (points_.capacity() * sizeof(Vec3) <= budget_ && points_.capacity() > t_spare_points.capacity())
-    t_spare_points = std::move(points_);
-}
+OriginalPoints::~OriginalPoints() { give_spare(std::move(points_), budget_); }
 
 void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
                    double shell, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,

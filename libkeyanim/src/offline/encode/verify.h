@@ -106,10 +106,7 @@ class FrameMarks {
 // each). Held only where they take at most `budget` bytes (96 per node and frame and reading);
 // otherwise empty, and verify_window poses the original with each frame as before. The same
 // points either way, bit for bit (measured_points of four rows is that of each row alone).
-// Their storage is kept for the next clip encoded on the same thread (up to `budget` bytes):
-// a fresh megabyte per clip came back as page faults every time (glibc returns the top of its
-// heap when it is freed), which made Bandai bow_feminine_001's encode 9.5 -> 11.5 ms instead
-// of 9.5 -> 9.0 (one thread, median of 15 in one process).
+// Their storage goes to the next clip encoded on the thread (spare.h).
 class OriginalPoints {
  public:
   OriginalPoints() = default;
