@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "keyanim/bank.h"
@@ -138,6 +139,24 @@ TEST_CASE("a bank's clips sample as their own files, in both profiles, with and 
   off::BankOptions o;
   o.runtime = true;
   check_bank_clips(off::write_bank(inputs(), o), true);
+}
+
+TEST_CASE("a zstd context kept from the thread's earlier files changes no byte") {
+  // write_kanim and write_bank keep their zstd context for the next file on the thread. The
+  // files of a fresh thread (no context kept) are the reference; here, after other clips and
+  // a bank with a dictionary, the same clip and bank give the same bytes.
+  const off::EncodedClip& clip = inputs()[0].clip;
+  off::BankOptions with_dictionary;
+  with_dictionary.dictionary = off::BankDictionary::always;
+  std::vector<uint8_t> fresh_file, fresh_bank;
+  std::thread([&] { fresh_file = off::write_kanim(clip); }).join();
+  std::thread([&] { fresh_bank = off::write_bank(inputs(), with_dictionary).bytes; }).join();
+  const off::WrittenBank bank = off::write_bank(inputs(), with_dictionary);
+  REQUIRE(bank.dictionary_bytes > 0);
+  CHECK(bank.bytes == fresh_bank);
+  (void)off::write_kanim(inputs()[2].clip, 3);  // another clip at another level
+  CHECK(off::write_kanim(clip) == fresh_file);  // after a dictionary and another level
+  CHECK(off::write_bank(inputs(), with_dictionary).bytes == fresh_bank);
 }
 
 TEST_CASE("the skeleton is stored once") {

@@ -113,7 +113,10 @@ void channel_signal(const Motion& m, const ChannelLayout& layout, uint32_t c, st
 Signals::Signals(const Motion& m, const ChannelLayout& layout, size_t budget, unsigned threads)
     : frames_(m.frame_count), budget_(budget) {
   const size_t channels = layout.node.size();
-  if (channels == 0 || frames_ == 0 || size_t(frames_) * channels * sizeof(double) > budget) return;
+  if (channels == 0 || frames_ == 0 || size_t(frames_) * channels * sizeof(double) > budget) {
+    drop_spare<double>();
+    return;
+  }
   values_ = take_spare<double>();
   values_.resize(size_t(frames_) * channels);
   parallel_for(channels, threads, [&](size_t c, unsigned) {

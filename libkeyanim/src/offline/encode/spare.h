@@ -5,7 +5,8 @@
 // returns the top of its heap to the system when it is freed): Bandai bow_feminine_001's encode
 // took 11.5 ms instead of 9.0 (one thread, median of 15 in one process). A table takes the
 // thread's spare vector of its type and gives its own back when it is done, if it is within its
-// budget; so a thread keeps at most one budget's worth per type between encodes.
+// budget; so a thread keeps at most one budget's worth per type between encodes, and none
+// after a clip whose tables are over it.
 #pragma once
 #include <cstddef>
 #include <utility>
@@ -26,6 +27,13 @@ std::vector<T> take_spare() {
   thread_spare<T>() = {};
   v.clear();
   return v;
+}
+
+// Frees the thread's spare storage of T: a table over its budget is not held, and the clip
+// that needs none should not carry an earlier clip's (its memory may be a target).
+template <class T>
+void drop_spare() {
+  std::vector<T>().swap(thread_spare<T>());
 }
 
 // Keeps `v`'s storage for the next table of T on this thread if it takes at most `budget`

@@ -159,8 +159,11 @@ void pose_rows(const Skeleton& s, const std::array<const double*, 4>& rows, doub
 OriginalPoints::OriginalPoints(const Motion& m, double shell, size_t budget, unsigned threads) : budget_(budget) {
   const std::span<const PositionReading> readings = measured_readings(m.skeleton);
   const size_t per_frame = size_t(kPointsPerNode) * m.skeleton.joints.size();
-  if (m.frame_count == 0 || per_frame == 0 || size_t(m.frame_count) * per_frame * sizeof(Vec3) * readings.size() > budget)
+  if (m.frame_count == 0 || per_frame == 0 ||
+      size_t(m.frame_count) * per_frame * sizeof(Vec3) * readings.size() > budget) {
+    drop_spare<Vec3>();
     return;
+  }
   points_ = take_spare<Vec3>();
   points_.resize(readings.size() * size_t(m.frame_count) * per_frame);
   per_frame_ = per_frame, frames_ = m.frame_count;
