@@ -84,15 +84,16 @@ struct SegmentOperands {
   bool linear = false;
 };
 
-// A key of a segment's window, and whether the channel has it (a missing one is an end point,
-// duplicated: its value is the segment's nearer key's, and its tangent scale is 1).
+// A key of a segment's window (the segment's two keys and the one on either side of them).
 struct WindowKey {
   uint32_t frame = 0;
   float value = 0.0f;
 };
 
 // Operands of the segment from key k0 to key k1, with the key before k0 (`before`) and after
-// k1 (`after`) where the channel has them (null at its ends).
+// k1 (`after`) where the channel has them. A missing one (null, at the channel's ends) is an
+// end point duplicated, as segment_operands does: its value is the nearer key's and its
+// tangent scale 1.
 inline SegmentOperands window_operands(const WindowKey* before, WindowKey k0, WindowKey k1, const WindowKey* after,
                                        Interpolation interp, float s, TangentRule rule) noexcept {
   SegmentOperands r;
