@@ -161,7 +161,7 @@ void CurveFit::measure(uint32_t start, bool push) {
   const uint32_t end = w_.next[start], p = w_.prev[start], n = w_.next[end];
   const Key before{p, p != kNone ? w_.v[p] : 0.0f}, after{n, n != kNone ? w_.v[n] : 0.0f};
   const SegmentOperands ops = window_operands(p != kNone ? &before : nullptr, {start, w_.v[start]},
-                                               {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
+                                              {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
   uint32_t arg = 0;
   const double worst = worst_ratio(y_, tol_, ops, start, end, arg);
   w_.seg_ratio[start] = worst, w_.seg_arg[start] = arg;
@@ -409,7 +409,7 @@ bool ChannelFitter::segments_within(const Candidate& c, const double* y, Toleran
     const Key before = i > 0 ? Key{k[i - 1], key_value(y[k[i - 1]], c.step)} : Key{};
     const Key after = i + 2 < k.size() ? Key{k[i + 2], key_value(y[k[i + 2]], c.step)} : Key{};
     const SegmentOperands ops = window_operands(i > 0 ? &before : nullptr, a, b, i + 2 < k.size() ? &after : nullptr,
-                                                 c.interp, s, opt_.rule);
+                                                c.interp, s, opt_.rule);
     uint32_t arg = 0;
     return worst_ratio(y, tol, ops, a.frame, b.frame, arg) <= 1.0;
   });

@@ -237,7 +237,7 @@ uint32_t fit_within_tolerance(const Job& job) {
   const Signals signals = rounds ? Signals(m, job.layout, kSignalsBudget, job.threads) : Signals();
   for (uint32_t round = 0;; ++round) {
     fit_channels(job, round, budgets, fitters, marks, signals);
-    if (job.settings.key_mode != KeyMode::error || m.frame_count == 0) return round + 1;
+    if (!rounds || m.frame_count == 0) return round + 1;
     if (!verify_and_tighten(job, round, budgets, marks, originals)) return round + 1;
     if (round + 1 >= kMaxRounds)
       throw Error(ErrorKind::limit, "could not reach the tolerance of " + general_text(job.tol_units) +

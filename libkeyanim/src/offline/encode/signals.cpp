@@ -120,7 +120,7 @@ Signals::Signals(const Motion& m, const ChannelLayout& layout, size_t budget, un
   values_ = take_spare<double>();
   values_.resize(size_t(frames_) * channels);
   parallel_for(channels, threads, [&](size_t c, unsigned) {
-    thread_local std::vector<double> column;
+    std::vector<double> column;  // once per channel: not worth a per-thread buffer kept afterwards
     channel_signal(m, layout, uint32_t(c), column);
     std::copy(column.begin(), column.end(), values_.begin() + ptrdiff_t(c * frames_));
   });

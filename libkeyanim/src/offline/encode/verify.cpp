@@ -36,7 +36,7 @@ void ChannelCursor::prepare() {
   const size_t j = j_, n = ch.frames.size();
   const Key before = j > 0 ? key_at(ch, j - 1) : Key{}, after = j + 2 < n ? key_at(ch, j + 2) : Key{};
   ops_ = window_operands(j > 0 ? &before : nullptr, key_at(ch, j), key_at(ch, j + 1), j + 2 < n ? &after : nullptr,
-                          ch.interp, tension_to_s(ch.tension), rule_);
+                         ch.interp, tension_to_s(ch.tension), rule_);
   prepared_ = j;
 }
 
