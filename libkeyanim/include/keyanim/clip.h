@@ -13,6 +13,7 @@
 
 #include "keyanim/cardinal.h"
 #include "keyanim/pose.h"
+#include "keyanim/rotation.h"
 #include "keyanim/skeleton.h"
 #include "keyanim/status.h"
 
@@ -41,11 +42,20 @@ struct DecodeLimits {
   bool check_content = false;
 };
 
-// What a channel is, independent of how a loaded clip stores it.
+// What a channel's keys hold (spec/FORMAT.md section 4.7).
+enum class StoredAs : uint8_t {
+  value = 0,   // the channel's own values (a position, or an Euler angle)
+  quat_x = 1,  // x, y or z of its node's rotation relative to the node's reference (QuatNode):
+  quat_y = 2,  // the node's three rotation channels hold these, and sample() gives its Euler
+  quat_z = 3,  // angles computed from them
+};
+
+// What a channel's keys are, independent of how a loaded clip stores them.
 struct ChannelInfo {
   Interpolation interp = Interpolation::cardinal;
   float tension = 0.0f;    // T in [-1, 1] (s = (1 - T) / 2); ignored by linear channels
   uint32_t key_count = 0;  // 0: all zeros; 1: constant
+  StoredAs stored = StoredAs::value;
 };
 
 class Cursor;
@@ -121,9 +131,14 @@ class Clip {
   TangentRule tangent_rule() const noexcept;
   const Skeleton& skeleton() const noexcept;
   uint64_t total_keys() const noexcept;
-  // Channel c (< channel_count()): interpolation, tension and number of keys.
+  // Channel c (< channel_count()): interpolation, tension, number of keys, and what they hold.
   ChannelInfo channel(uint32_t c) const noexcept;
-  // Channel c's keys: frames (strictly increasing) and values, exactly as the sampler uses them.
+  // Nodes whose rotation is stored as quaternion curves (version 5: spec/FORMAT.md section 4.7),
+  // in increasing node order; none in older files and in clips encoded with Euler rotations.
+  uint32_t quat_node_count() const noexcept;
+  QuatNode quat_node(uint32_t i) const noexcept;  // i < quat_node_count(); else a default QuatNode
+  // Channel c's keys: frames (strictly increasing) and values, exactly as the sampler uses them
+  // (a quaternion node's rotation channels: its stored x, y, z, channel(c).stored).
   // Both spans must hold channel(c).key_count entries (output_too_small); c >= channel_count()
   // is invalid_argument. Reads the image; meant for tools, not for a frame loop.
   Status channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<float> values) const noexcept;
@@ -148,8 +163,13 @@ class Clip {
   // exactly as spec/FORMAT.md Appendix A computes it, with f rounded to binary32. `out` must
   // hold channel_count() values (output_too_small); a NaN position is invalid_argument. With a
   // cursor (Cursor::prepare'd for this clip, else invalid_argument) playback forward is
-  // faster; the values are the same. Never allocates.
+  // faster; the values are the same. Never allocates. A quaternion node's rotation channels
+  // hold the Euler angles of its rotation in their order (Appendix B: computed in binary64
+  // from the stored x, y, z, the middle angle in [-90, 90], rounded to binary32).
   Status sample(double frame_position, std::span<float> out, Cursor* cursor = nullptr) const noexcept;
+  // The same, but a quaternion node's rotation channels hold its stored x, y, z (what its keys
+  // interpolate: Appendix A's values), for converters that compute the angles themselves.
+  Status sample_stored(double frame_position, std::span<float> out, Cursor* cursor = nullptr) const noexcept;
   // Same at a time in seconds: frame position = seconds / frame_time (0 if frame_time is 0).
   Status sample_time(double seconds, std::span<float> out, Cursor* cursor = nullptr) const noexcept;
   // Only the listed channels (e.g. one joint's), out[i] for channels[i]. A channel number

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "keyanim/cardinal.h"
+#include "keyanim/rotation.h"
 #include "keyanim/skeleton.h"
 
 namespace keyanim::internal {
@@ -57,6 +58,9 @@ struct ClipSource {
   // values, |q| <= 2^53, finite once dequantized.
   std::vector<uint32_t, NoZeroAllocator<uint32_t>> frames;
   std::vector<int64_t, NoZeroAllocator<int64_t>> q;
+  // Nodes stored as quaternions (version 5, QUAT), increasing: each one's rotation channels
+  // c, c + 1, c + 2 hold x, y, z with equal interpolation, tension and key frames.
+  std::vector<QuatNode> quat_nodes;
   std::string notes;
 };
 

@@ -38,6 +38,7 @@ inline constexpr uint32_t kTagKtim = make_tag('K', 'T', 'I', 'M');
 inline constexpr uint32_t kTagKval = make_tag('K', 'V', 'A', 'L');
 inline constexpr uint32_t kTagNote = make_tag('N', 'O', 'T', 'E');
 inline constexpr uint32_t kTagImag = make_tag('I', 'M', 'A', 'G');
+inline constexpr uint32_t kTagQuat = make_tag('Q', 'U', 'A', 'T');  // version 5 (section 4.7)
 // The critical sections, in the order a file must list them: the archive profile's, and the
 // runtime profile's (entries 0 and 1 exactly, so that IMAG starts 8-aligned: section 9.1).
 inline constexpr uint32_t kCriticalTags[5] = {kTagClip, kTagSkel, kTagChan, kTagKtim, kTagKval};
@@ -46,6 +47,17 @@ inline constexpr uint32_t kRuntimeTags[3] = {kTagClip, kTagImag, kTagSkel};
 // it (kMemberSlots: their places in kCriticalTags), and the runtime profile's first two.
 inline constexpr uint32_t kMemberTags[4] = {kTagClip, kTagChan, kTagKtim, kTagKval};
 inline constexpr int kMemberSlots[4] = {0, 2, 3, 4};
+// Version 5's archive profile adds QUAT after SKEL (kQuatSlot: its index among the loader's
+// critical sections, after kCriticalTags' five); a member's has no SKEL.
+inline constexpr int kQuatSlot = 5;
+inline constexpr uint32_t kCriticalTagsV5[6] = {kTagClip, kTagSkel, kTagQuat, kTagChan, kTagKtim, kTagKval};
+inline constexpr int kCriticalSlotsV5[6] = {0, 1, kQuatSlot, 2, 3, 4};
+inline constexpr uint32_t kMemberTagsV5[5] = {kTagClip, kTagQuat, kTagChan, kTagKtim, kTagKval};
+inline constexpr int kMemberSlotsV5[5] = {0, kQuatSlot, 2, 3, 4};
+inline constexpr size_t kQuatHeaderBytes = 4;  // Quat_Count
+inline constexpr size_t kQuatEntryBytes = 20;  // Node u32, Reference f32[4]
+// A reference is a unit quaternion rounded to binary32: |x^2 + y^2 + z^2 + w^2 - 1| <= 2^-10.
+inline constexpr double kQuatNormSlack = 1.0 / 1024.0;
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count
@@ -76,5 +88,7 @@ inline constexpr uint32_t kZstdMagic = 0xFD2FB528u;
 // status the file would fail with later (zstd_error, corrupt): the refusal is only earlier.
 inline constexpr uint64_t kMaxZstdExpansion = 32768;
 inline constexpr uint64_t kMaxKeysPerFileByte = kMaxZstdExpansion;
+// From version 5 a key frame of KTIM is shared by a quaternion node's three curves.
+inline constexpr uint64_t kMaxKeysPerFileByteV5 = 3 * kMaxZstdExpansion;
 
 }  // namespace keyanim::internal

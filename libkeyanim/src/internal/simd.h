@@ -5,6 +5,7 @@
 // operation per lane, rounded to nearest, as the scalar code computes it: results are
 // bit-identical to the scalar path. Comparisons give lane masks (all ones or all zeros) as F4.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <utility>
@@ -45,6 +46,8 @@ inline F4 cmp_eq(F4 a, F4 b) { return F4(_mm_cmpeq_ps(a.v, b.v)); }
 inline F4 cmp_ge(F4 a, F4 b) { return F4(_mm_cmpge_ps(a.v, b.v)); }
 inline F4 cmp_not_gt(F4 a, F4 b) { return F4(_mm_cmpngt_ps(a.v, b.v)); }  // !(a > b)
 inline F4 mask_or(F4 a, F4 b) { return F4(_mm_or_ps(a.v, b.v)); }
+inline F4 sqrt_lanes(F4 a) { return F4(_mm_sqrt_ps(a.v)); }  // correctly rounded, as std::sqrt
+inline F4 max0(F4 a) { return F4(_mm_max_ps(a.v, _mm_setzero_ps())); }  // a > 0 ? a : 0 (NaN: 0)
 // Lanes of `mask` all ones take a, all zeros take b.
 inline F4 select(F4 mask, F4 a, F4 b) { return F4(_mm_or_ps(_mm_and_ps(mask.v, a.v), _mm_andnot_ps(mask.v, b.v))); }
 // Rows to columns: after the call a holds the first lane of a, b, c, d, and so on.
@@ -87,6 +90,8 @@ KEYANIM_F4_OP(*)
 KEYANIM_F4_OP(/)
 #undef KEYANIM_F4_OP
 inline I4 operator-(I4 a, I4 b) { I4 r; for (int i = 0; i < 4; ++i) r.v[i] = a.v[i] - b.v[i]; return r; }
+inline F4 sqrt_lanes(F4 a) { F4 r; for (int i = 0; i < 4; ++i) r.v[i] = std::sqrt(a.v[i]); return r; }
+inline F4 max0(F4 a) { F4 r; for (int i = 0; i < 4; ++i) r.v[i] = a.v[i] > 0.0f ? a.v[i] : 0.0f; return r; }
 inline F4 to_float(I4 a) { F4 r; for (int i = 0; i < 4; ++i) r.v[i] = static_cast<float>(a.v[i]); return r; }
 inline F4 lane_mask(const bool* b) {
   F4 r;

@@ -69,6 +69,9 @@ KEYANIM_INLINE inline F8 select(F8 mask, F8 a, F8 b) {
   const V8i m = V8i(mask.v);
   return lane_mask((m & V8i(a.v)) | (~m & V8i(b.v)));
 }
+// Each half as F4's (one correctly rounded square root per lane).
+KEYANIM_INLINE inline F8 sqrt_lanes(F8 a) { return F8::join(sqrt_lanes(a.low()), sqrt_lanes(a.high())); }
+KEYANIM_INLINE inline F8 max0(F8 a) { return select(lane_mask(a.v > V8f{}), a, F8(0.0f)); }  // a > 0 ? a : 0
 
 }  // namespace keyanim::internal
 #else

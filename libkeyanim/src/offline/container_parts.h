@@ -52,6 +52,11 @@ uint32_t crc32_of(const uint8_t* p, size_t n);  // the archive profile's checksu
 std::vector<uint8_t> clip_section(uint32_t frame_count, const Skeleton& skeleton, size_t channels, TangentRule rule,
                                   double frame_time, uint64_t keys);
 std::vector<uint8_t> skel_section(const Skeleton& skel);
+std::vector<uint8_t> quat_section(const std::vector<QuatNode>& nodes);  // QUAT's content (4.7)
+// The archive profile's major version of `clip`: 5 with quaternion nodes, else 3; the runtime
+// profile's: 5 with quaternion nodes, else 4.
+uint16_t archive_version_major(const EncodedClip& clip);
+uint16_t runtime_version_major(const Clip& clip);
 // Signature, header, table and the sections' bytes, with room reserved for the checksum the
 // caller appends (checksum_size bytes).
 std::vector<uint8_t> assemble(const std::vector<Section>& sections, uint16_t major, uint16_t minor, uint32_t flags,

@@ -27,8 +27,12 @@ std::vector<Section> runtime_sections(const Clip& clip) {
   return sections;
 }
 
+uint16_t runtime_version_major(const Clip& clip) {
+  return clip.quat_node_count() > 0 ? kQuatFormatVersionMajor : kRuntimeFormatVersionMajor;
+}
+
 std::vector<uint8_t> write_kanim_runtime(const Clip& clip) {
-  std::vector<uint8_t> out = assemble(runtime_sections(clip), kRuntimeFormatVersionMajor, kRuntimeFormatVersionMinor,
+  std::vector<uint8_t> out = assemble(runtime_sections(clip), runtime_version_major(clip), 0,
                                       internal::kHeaderRuntime, internal::kRuntimeChecksumSize);
   internal::put_le<uint64_t>(out, internal::xxh64_of(out.data(), out.size()));
   return out;
@@ -41,6 +45,7 @@ EncodedClip encoded_clip(const Clip& clip) {
   out.frame_count = src.frame_count;
   out.frame_time = src.frame_time;
   out.tangent_rule = src.rule;
+  out.quat_nodes = src.quat_nodes;
   out.notes = src.notes;
   out.channels.resize(src.channels.size());
   for (size_t c = 0; c < src.channels.size(); ++c) {

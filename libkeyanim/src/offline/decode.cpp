@@ -65,7 +65,31 @@ void FrameDecoder::start(const Clip& clip, const ResampleOptions& options) {
     count_ = span * (uint64_t(options.inbetweens) + 1) + 1;  // < 2^64: both factors < 2^32
   }
   pose_.assign(clip.channel_count(), 0.0f);
+  quats_.resize(clip.quat_node_count());
+  for (uint32_t i = 0; i < quats_.size(); ++i) {
+    QuatAngles& q = quats_[i];
+    q.node = clip.quat_node(i);
+    const Joint& j = clip.skeleton().joints[q.node.node];
+    uint32_t first = 0;
+    quaternion_capable(j, &first);
+    q.column = j.first_channel + first;
+    for (uint32_t k = 0; k < 3; ++k) q.axes[k] = static_cast<uint8_t>(channel_axis(j.channels[first + k]));
+    q.have_previous = false;
+  }
   if (cursor_.prepare(clip) != Status::ok) throw std::bad_alloc();
+}
+
+// A quaternion node's channels in `row`: its Euler angles in binary64 from the stored x, y, z
+// (Appendix B), the solution nearest the frame decoded before (continuous channels).
+void FrameDecoder::quat_angles(QuatAngles& q, std::span<double> row) {
+  const float* xyz = pose_.data() + q.column;
+  double rotation[4], deg[3];
+  stored_rotation(q.node.reference, xyz[0], xyz[1], xyz[2], rotation);
+  euler_from_quaternion(rotation, q.axes, deg);
+  if (q.have_previous) nearest_euler(q.previous, deg);
+  for (uint32_t k = 0; k < 3; ++k) q.previous[k] = deg[k];
+  q.have_previous = true;
+  for (uint32_t k = 0; k < 3 && q.column + k < row.size(); ++k) row[q.column + k] = deg[k];
 }
 
 void FrameDecoder::frame(uint64_t i, std::span<double> row) {
@@ -80,8 +104,9 @@ void FrameDecoder::frame(uint64_t i, std::span<double> row) {
   else
     position = static_cast<double>(first_ + i);
   if (position > last_) position = last_;  // the 1e-6 slack may overshoot by a hair
-  clip_->sample(position, pose_, &cursor_);
+  clip_->sample_stored(position, pose_, &cursor_);
   for (size_t c = 0; c < pose_.size() && c < row.size(); ++c) row[c] = static_cast<double>(pose_[c]);
+  for (QuatAngles& q : quats_) quat_angles(q, row);
 }
 
 Motion decode_motion(const Clip& clip, const ResampleOptions& options) {

@@ -31,6 +31,7 @@ const Image& empty_image() {
   static const Image kEmpty = [] {
     Image i;
     i.rig = std::shared_ptr<const internal::Rig>(std::shared_ptr<const internal::Rig>(), &kEmptyRig);
+    i.euler = &kEmptyRig.euler;
     return i;
   }();
   return kEmpty;
@@ -76,10 +77,75 @@ double Clip::duration() const noexcept {
   return img.frame_count == 0 ? 0.0 : static_cast<double>(img.frame_count - 1) * img.frame_time;
 }
 
+namespace {
+
+// The quaternion node (index into the image's) whose rotation channels hold channel c, and
+// which of them c is (0 x, 1 y, 2 z); false for a channel of its own values.
+bool quat_of_channel(const Image& img, uint32_t c, uint32_t& quat, uint32_t& component) noexcept {
+  const auto& col = img.quat_column;
+  const auto it = std::upper_bound(col.begin(), col.end(), c);  // columns increase with the nodes
+  if (it == col.begin() || c - *(it - 1) >= 3) return false;
+  quat = static_cast<uint32_t>(it - col.begin()) - 1;
+  component = c - *(it - 1);
+  return true;
+}
+
+// Quaternion node i's Euler angles (degrees, its rotation channels' order) from its stored x,
+// y, z: Appendix B, in binary64.
+void quat_euler(const Image& img, uint32_t i, const float (&xyz)[3], float (&out)[3]) noexcept {
+  float ref[4];
+  for (uint32_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
+  double q[4], deg[3];
+  stored_rotation(ref, xyz[0], xyz[1], xyz[2], q);
+  const Joint& j = img.rig->skeleton.joints[img.quat_node[i]];
+  const uint32_t first = img.quat_column[i] - j.first_channel;
+  const uint8_t axes[3] = {static_cast<uint8_t>(channel_axis(j.channels[first])),
+                           static_cast<uint8_t>(channel_axis(j.channels[first + 1])),
+                           static_cast<uint8_t>(channel_axis(j.channels[first + 2]))};
+  euler_from_quaternion(q, axes, deg);
+  for (int k = 0; k < 3; ++k) out[k] = static_cast<float>(deg[k]);
+}
+
+// Every quaternion node's rotation channels of a whole row of stored values, in place.
+void euler_in_place(const Image& img, float* row) noexcept {
+  for (uint32_t i = 0; i < img.quat_node.size(); ++i) {
+    float* at = row + img.quat_column[i];
+    const float xyz[3] = {at[0], at[1], at[2]};
+    float deg[3];
+    quat_euler(img, i, xyz, deg);
+    std::copy(deg, deg + 3, at);
+  }
+}
+
+// Channel c's value at f, given that it is component `component` of quaternion node `quat`.
+float quat_channel(const Image& img, uint32_t quat, uint32_t component, float f) noexcept {
+  const uint32_t column = img.quat_column[quat];
+  const uint32_t columns[3] = {column, column + 1, column + 2};
+  float xyz[3], deg[3];
+  internal::sample_listed(img, f, columns, 3, xyz);
+  quat_euler(img, quat, xyz, deg);
+  return deg[component];
+}
+
+}  // namespace
+
 ChannelInfo Clip::channel(uint32_t c) const noexcept {
   const Image& img = KEYANIM_IMG;
   if (c >= img.interp.size()) return {};
-  return {img.interp[c], img.tension[c], img.key_count[c]};
+  uint32_t quat = 0, component = 0;
+  const StoredAs stored = quat_of_channel(img, c, quat, component) ? static_cast<StoredAs>(component + 1) : StoredAs::value;
+  return {img.interp[c], img.tension[c], img.key_count[c], stored};
+}
+
+uint32_t Clip::quat_node_count() const noexcept { return static_cast<uint32_t>(KEYANIM_IMG.quat_node.size()); }
+
+QuatNode Clip::quat_node(uint32_t i) const noexcept {
+  const Image& img = KEYANIM_IMG;
+  QuatNode n;
+  if (i >= img.quat_node.size()) return n;
+  n.node = img.quat_node[i];
+  for (uint32_t k = 0; k < 4; ++k) n.reference[k] = img.quat_reference[k * img.quat_lanes + i];
+  return n;
 }
 
 Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<float> values) const noexcept {
@@ -104,16 +170,13 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
   // Walk the records block by block: each lists its block's keys in its mask.
   uint32_t k = 0;
   for (uint32_t b = 0; b < img.block_count && k < n; ++b) {
-    const uint8_t* rec = img.record(b, curve);
-    uint64_t mask;
-    std::memcpy(&mask, rec, 8);
-    const uint32_t vw = rec[8], kw = rec[9];
-    const uint64_t base_at = internal::kRecordBitsAt + 4ull * kw;
-    const uint64_t base = internal::read_bits(rec, base_at, cv.base_bits);
-    uint64_t at = base_at + cv.base_bits + 2ull * vw;  // the block's first key follows two context keys
-    for (; mask != 0 && k < n; mask &= mask - 1, at += vw, ++k) {
+    internal::CurveFields f;
+    const uint8_t* rec = internal::curve_record(img, b, curve, f);
+    const uint64_t base = internal::read_bits(rec, f.base_at, cv.base_bits);
+    uint64_t at = f.values_at + 2ull * f.value_bits;  // the block's first key follows two context keys
+    for (uint64_t mask = f.mask; mask != 0 && k < n; mask &= mask - 1, at += f.value_bits, ++k) {
       frames[k] = (b << internal::kBlockShift) + static_cast<uint32_t>(internal::low_bit(mask));
-      values[k] = dequantize(cv.q_base + static_cast<int64_t>(base + internal::read_bits(rec, at, vw)), cv.step);
+      values[k] = dequantize(cv.q_base + static_cast<int64_t>(base + internal::read_bits(rec, at, f.value_bits)), cv.step);
     }
   }
   return k == n ? Status::ok : Status::invalid_argument;  // k < n cannot happen for a loaded clip
@@ -122,13 +185,23 @@ Status Clip::channel_keys(uint32_t c, std::span<uint32_t> frames, std::span<floa
 Status Clip::sample_channel(uint32_t c, float frame_position, float& out) const noexcept {
   const Image& img = KEYANIM_IMG;
   if (c >= img.interp.size() || std::isnan(frame_position)) return Status::invalid_argument;
-  internal::sample_listed(img, frame_position, &c, 1, &out);
+  uint32_t quat = 0, component = 0;
+  if (quat_of_channel(img, c, quat, component))
+    out = quat_channel(img, quat, component, frame_position);
+  else
+    internal::sample_listed(img, frame_position, &c, 1, &out);
   return Status::ok;
 }
 
 // ---- Sampling
 
 Status Clip::sample(double frame_position, std::span<float> out, Cursor* cursor) const noexcept {
+  const Status s = sample_stored(frame_position, out, cursor);
+  if (s == Status::ok) euler_in_place(KEYANIM_IMG, out.data());
+  return s;
+}
+
+Status Clip::sample_stored(double frame_position, std::span<float> out, Cursor* cursor) const noexcept {
   if (std::isnan(frame_position)) return Status::invalid_argument;
   const Image& img = KEYANIM_IMG;
   if (out.size() < img.interp.size()) return Status::output_too_small;
@@ -156,8 +229,11 @@ Status Clip::sample_channels(double frame_position, std::span<const uint32_t> ch
   if (channels.size() > UINT32_MAX) return Status::invalid_argument;
   for (uint32_t c : channels)
     if (c >= img.interp.size()) return Status::invalid_argument;
-  internal::sample_listed(img, static_cast<float>(frame_position), channels.data(),
-                          static_cast<uint32_t>(channels.size()), out.data());
+  const float f = static_cast<float>(frame_position);
+  internal::sample_listed(img, f, channels.data(), static_cast<uint32_t>(channels.size()), out.data());
+  uint32_t quat = 0, component = 0;
+  for (size_t i = 0; i < channels.size(); ++i)  // a quaternion node's angle needs its x, y and z
+    if (quat_of_channel(img, channels[i], quat, component)) out[i] = quat_channel(img, quat, component, f);
   return Status::ok;
 }
 

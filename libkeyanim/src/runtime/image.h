@@ -21,6 +21,11 @@
 //   Base          wc            the record's smallest q minus the curve's q_base (wc per curve)
 //   Values        n x w         q - q_base - Base of the window's n = popcount(Mask) + 4 keys,
 //                               in frame order: two before, the block's keys, two after
+//
+// A quaternion node's three curves share their key frames (version 5), so they share a record:
+// its track's. Such a record has the Mask, three Value_Bits (x, y, z: bytes 8-10) and
+// Context_Bits (byte 11), the Context from bit 96, then the three Bases, then the three curves'
+// Values one after the other: one search of the mask gives the window of all three.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -46,6 +51,8 @@ namespace keyanim::internal {
 inline constexpr uint32_t kBlockShift = 6;
 inline constexpr uint32_t kBlockFrames = 1u << kBlockShift;
 inline constexpr uint32_t kRecordBitsAt = 80;  // Context starts after Mask, Value_Bits, Context_Bits
+inline constexpr uint32_t kTrackRecordBitsAt = 96;  // in a quaternion track's: three Value_Bits
+inline constexpr uint32_t kTrackCurves = 3;         // curves of a quaternion node's track
 inline constexpr uint32_t kContextKeys = 4;
 inline constexpr uint32_t kNoCurve = UINT32_MAX;
 inline constexpr uint32_t kMaxValueBits = 55;    // Value_Bits and Base_Bits (spec 9.3)
@@ -115,14 +122,34 @@ struct Image {
   std::span<const float> first_value, last_value;  // v_0 and v_{n-1}
   std::span<const uint32_t> curve_linear;    // all ones: linear interpolation
   std::span<const uint32_t> curve_channel;   // curve i's output column (channel)
+  // Quaternion nodes (version 5; none before): their nodes, the column of each one's x, and
+  // their references as four arrays of quat_lanes floats (x's, y's, z's, w's; padding lanes
+  // the identity), so that 4 or 8 nodes' rotations are built per register.
+  std::span<const uint32_t> quat_node, quat_column;
+  std::span<const float> quat_reference;
+  uint32_t quat_lanes = 0;
+  // The Euler nodes' rotation groups (pose.cpp): the rig's when the clip has no quaternion
+  // node, else `own_euler`, made for the clip's Euler nodes when it attaches (plan_rotations).
+  const EulerGroups* euler = nullptr;
+  EulerGroups own_euler;
+  // Block tracks: a quaternion node's three block curves are one track (one record per block),
+  // every other block curve a track of its own. track_first[t]: its first curve (increasing);
+  // empty without quaternion nodes, where track t is curve t.
+  std::span<const uint32_t> track_first;
+  uint32_t block_tracks = 0;
   uint32_t block_count = 0;
-  // [block * block_curves + curve]: byte offset in payload; kPrefetchRecords extra zeros at the
-  // end, so that the sampler may read the offset of a record a few curves ahead unchecked.
+  // [block * block_tracks + track]: byte offset in payload; kPrefetchRecords extra zeros at the
+  // end, so that the sampler may read the offset of a record a few tracks ahead unchecked.
   std::span<const uint32_t> record_offset;
   std::span<const uint8_t> payload;      // records, then kPayloadPadding zero bytes
 
-  const uint8_t* record(uint32_t block, uint32_t curve) const noexcept {
-    return payload.data() + record_offset[size_t(block) * block_curves + curve];
+  // Block curve `curve`'s track, and its place in it (0 x .. 2 z, or 0 alone).
+  struct TrackOf {
+    uint32_t track, component, curves;  // curves: 1, or kTrackCurves
+  };
+  TrackOf track_of(uint32_t curve) const noexcept;  // image_build.cpp
+  const uint8_t* track_record(uint32_t block, uint32_t track) const noexcept {
+    return payload.data() + record_offset[size_t(block) * block_tracks + track];
   }
   size_t skeleton_bytes() const noexcept { return rig->bytes(); }  // the rig's part
   size_t animation_bytes() const noexcept;  // the rest (image_build.cpp)
@@ -131,6 +158,8 @@ struct Image {
 
 // IMAG's counts: its header's, and CLIP's channel count.
 ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept;
+// Sets img.euler (the rig and the quaternion nodes known): the rig's groups, or the clip's own.
+void plan_rotations(Image& img);
 // Points `img`'s arrays into `imag` (IMAG's content, 8-aligned), whose header and sizes are
 // known to be valid (built by build_image, or checked by the viewer): no check here.
 void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) noexcept;
@@ -195,60 +224,117 @@ inline int32_t unzigzag32(uint64_t u) noexcept {
   return static_cast<int32_t>(static_cast<uint32_t>(u >> 1) ^ (0u - static_cast<uint32_t>(u & 1)));
 }
 
-// The four context frames of a record (relative to the block's start).
-[[gnu::always_inline]] inline void read_context(const uint8_t* rec, uint32_t kw, int32_t* c) noexcept {
+// The four context frames of a record whose Context starts at byte `at` (kRecordBitsAt / 8,
+// or kTrackRecordBitsAt / 8 in a quaternion track's), relative to the block's start.
+[[gnu::always_inline]] inline void read_context(const uint8_t* rec, uint32_t at, uint32_t kw, int32_t* c) noexcept {
   if (kw <= 16) {  // one load: offsets below 2^15, the usual case
     uint64_t x;
-    std::memcpy(&x, rec + kRecordBitsAt / 8, 8);
+    std::memcpy(&x, rec + at, 8);
     const uint64_t m = (uint64_t(1) << kw) - 1;
     c[0] = unzigzag32(x & m);
     c[1] = unzigzag32((x >> kw) & m);
     c[2] = unzigzag32((x >> (2 * kw)) & m);
     c[3] = unzigzag32((x >> (3 * kw)) & m);
   } else {
-    for (uint32_t k = 0; k < 4; ++k) c[k] = unzigzag32(read_bits(rec, kRecordBitsAt + k * kw, kw));
+    for (uint32_t k = 0; k < 4; ++k) c[k] = unzigzag32(read_bits(rec, 8 * uint64_t(at) + k * kw, kw));
   }
   c[2] += static_cast<int32_t>(kBlockFrames);
   c[3] += static_cast<int32_t>(kBlockFrames);
+}
+[[gnu::always_inline]] inline void read_context(const uint8_t* rec, uint32_t kw, int32_t* c) noexcept {
+  read_context(rec, kRecordBitsAt / 8, kw, c);
 }
 
 // Bits 0..t set: the frames of a block at or before block_start + t.
 inline uint64_t frames_upto(uint32_t t) noexcept { return t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1; }
 
-// `upto` is frames_upto(t) (the same for every curve of a pose: computed once).
+// The frames of the window around position t of a record with mask `mask` (its Context at byte
+// `at`, kw bits each): k_{j-1} .. k_{j+2} relative to the block's start, into `frame`; returns
+// how many of the block's keys lie at or before t. `upto` is frames_upto(t) (the same for
+// every curve of a pose: computed once).
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint64_t upto, Window& w) noexcept {
-  uint64_t mask;
-  std::memcpy(&mask, rec, 8);
-  const uint32_t vw = rec[8], kw = rec[9];
+[[gnu::always_inline]] inline uint32_t window_frames(const uint8_t* rec, uint64_t mask, uint32_t at, uint32_t kw,
+                                                     uint64_t upto, int32_t* frame) noexcept {
   // Keys up to t (bits 0..t) and after it; k_j, k_{j-1} are the highest keys at or below t,
   // k_{j+1}, k_{j+2} the lowest above, else the context keys before or after the block (read
   // only then: in a dense channel two keys on each side are the usual case).
   const uint64_t below = mask & upto;
   const uint64_t above = mask & ~upto;
-  const uint32_t count = popcount64<kPopcnt>(below);
   const int32_t top = top_bit(below | 1);  // | 1: defined when below is 0 (then unused)
   const uint64_t below_rest = below & ~(uint64_t(1) << top);
   const uint64_t above_rest = above & (above - 1);
   const uint64_t high = uint64_t(1) << 63;  // keeps low_bit defined (then unused)
   if (below_rest != 0 && above_rest != 0) [[likely]] {
-    w.frame[0] = top_bit(below_rest);
-    w.frame[1] = top;
-    w.frame[2] = low_bit(above);
-    w.frame[3] = low_bit(above_rest);
+    frame[0] = top_bit(below_rest);
+    frame[1] = top;
+    frame[2] = low_bit(above);
+    frame[3] = low_bit(above_rest);
   } else {
     int32_t c[4];
-    read_context(rec, kw, c);
-    w.frame[0] = below_rest ? top_bit(below_rest | 1) : (below ? c[1] : c[0]);
-    w.frame[1] = below ? top : c[1];
-    w.frame[2] = above ? low_bit(above | high) : c[2];
-    w.frame[3] = above_rest ? low_bit(above_rest | high) : (above ? c[2] : c[3]);
+    read_context(rec, at, kw, c);
+    frame[0] = below_rest ? top_bit(below_rest | 1) : (below ? c[1] : c[0]);
+    frame[1] = below ? top : c[1];
+    frame[2] = above ? low_bit(above | high) : c[2];
+    frame[3] = above_rest ? low_bit(above_rest | high) : (above ? c[2] : c[3]);
   }
+  return popcount64<kPopcnt>(below);
+}
+
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void read_window(const uint8_t* rec, uint32_t base_bits, uint64_t upto, Window& w) noexcept {
+  uint64_t mask;
+  std::memcpy(&mask, rec, 8);
+  const uint32_t vw = rec[8], kw = rec[9];
+  const uint32_t count = window_frames<kPopcnt>(rec, mask, kRecordBitsAt / 8, kw, upto, w.frame);
   // Values: two context keys, then `count` keys up to t; key j-1 is value `count`.
   const uint64_t base_at = kRecordBitsAt + 4 * uint64_t(kw);
   w.base = read_bits(rec, base_at, base_bits);
   w.value_bits = vw;
   w.at = base_at + base_bits + uint64_t(count) * vw;
+}
+
+// Where one curve's fields lie in its block's record (its own, or its quaternion track's):
+// for the paths that read one curve at a time (streams, key lists, checks).
+struct CurveFields {
+  uint64_t mask = 0;
+  uint32_t context_at = 0;  // byte of Context
+  uint32_t context_bits = 0, value_bits = 0;
+  uint64_t base_at = 0;     // bit of Base
+  uint64_t values_at = 0;   // bit of Values[0]
+  uint64_t end = 0;         // bits of the whole record
+};
+// Component k of a record of `curves` curves (1, or kTrackCurves), whose Base_Bits are
+// base_bits[0 .. curves).
+inline CurveFields curve_fields(const uint8_t* rec, uint32_t k, uint32_t curves, const uint32_t* base_bits) noexcept {
+  CurveFields f;
+  std::memcpy(&f.mask, rec, 8);
+  const uint64_t n = uint64_t(__builtin_popcountll(f.mask)) + kContextKeys;  // values per curve
+  const uint32_t header = curves == 1 ? kRecordBitsAt : kTrackRecordBitsAt;
+  f.context_at = header / 8;
+  f.context_bits = rec[header / 8 - 1];
+  f.value_bits = rec[8 + k];
+  uint64_t at = header + uint64_t(kContextKeys) * f.context_bits;
+  for (uint32_t i = 0; i < curves; ++i) {
+    if (i == k) f.base_at = at;
+    at += base_bits[i];
+  }
+  for (uint32_t i = 0; i < curves; ++i) {
+    if (i == k) f.values_at = at;
+    at += n * rec[8 + i];
+  }
+  f.end = at;
+  return f;
+}
+
+// Block `block`'s record of block curve `curve` (its own, or its quaternion track's), with
+// where its fields lie in it.
+inline const uint8_t* curve_record(const Image& img, uint32_t block, uint32_t curve, CurveFields& f) noexcept {
+  const Image::TrackOf t = img.track_of(curve);
+  uint32_t base_bits[kTrackCurves];
+  for (uint32_t k = 0; k < t.curves; ++k) base_bits[k] = img.curves[curve - t.component + k].base_bits;
+  const uint8_t* rec = img.track_record(block, t.track);
+  f = curve_fields(rec, t.component, t.curves, base_bits);
+  return rec;
 }
 
 // The window's four values (see Window).

@@ -9,6 +9,7 @@
 #include <limits>
 #include <utility>
 
+#include "internal/quat_layout.h"
 #include "runtime/image.h"
 #include "runtime/rig_cache_access.h"
 
@@ -21,9 +22,9 @@ uint64_t zigzag(int64_t d) noexcept { return (static_cast<uint64_t>(d) << 1) ^ s
 // A curve's keys (n >= 2), extended on both sides by virtual keys that repeat the end values at
 // the end segments' spacing: index i < 0 or i >= n is such a key.
 struct Keys {
-  const uint32_t* k;
-  const int64_t* q;
-  int64_t n;
+  const uint32_t* k = nullptr;
+  const int64_t* q = nullptr;
+  int64_t n = 0;
   int64_t frame(int64_t i) const noexcept {
     if (i < 0) return int64_t(k[0]) + (int64_t(k[1]) - int64_t(k[0])) * i;
     if (i >= n) return int64_t(k[n - 1]) + (int64_t(k[n - 1]) - int64_t(k[n - 2])) * (i - n + 1);
@@ -32,33 +33,40 @@ struct Keys {
   int64_t value(int64_t i) const noexcept { return q[std::clamp<int64_t>(i, 0, n - 1)]; }
 };
 
-// One record's window: keys first - 2 .. last + 1, where [first, last) are the block's keys.
+// One record's window: keys first - 2 .. last + 1, where [first, last) are the block's keys;
+// for a quaternion track, of each of its three curves (which share their key frames).
 struct RecordPlan {
   int64_t first = 0, last = 0;
-  uint64_t base = 0;      // smallest value in the window, minus q_base
-  uint32_t value_bits = 0, context_bits = 0;
+  uint32_t curves = 1;
+  uint64_t base[kTrackCurves] = {};  // per curve, the smallest value in the window, minus q_base
+  uint32_t value_bits[kTrackCurves] = {}, context_bits = 0;
   uint64_t size_bytes = 0;
 };
 
-RecordPlan plan_record(const Keys& keys, int64_t first, int64_t last, int64_t start, int64_t q_base,
-                       uint32_t base_bits) {
+// A track's curves: `curves` of them from `keys` and `cv` (their Keys and Curve facts).
+RecordPlan plan_record(const Keys* keys, const Curve* cv, uint32_t curves, int64_t first, int64_t last, int64_t start) {
   RecordPlan r;
   r.first = first;
   r.last = last;
-  // The window's values: the keys first - 2 .. last + 1 clamped to the curve (virtual keys
-  // repeat the end values).
-  const int64_t* q = keys.q + std::max<int64_t>(first - 2, 0);
-  const int64_t* q_end = keys.q + std::min(last + 1, keys.n - 1) + 1;
-  int64_t lo = *q, hi = *q;
-  for (; q < q_end; ++q) lo = std::min(lo, *q), hi = std::max(hi, *q);
-  r.base = static_cast<uint64_t>(lo - q_base);
-  r.value_bits = bit_width(static_cast<uint64_t>(hi - lo));
+  r.curves = curves;
+  uint64_t bits = (curves == 1 ? kRecordBitsAt : kTrackRecordBitsAt);
+  for (uint32_t k = 0; k < curves; ++k) {
+    // The window's values: the keys first - 2 .. last + 1 clamped to the curve (virtual keys
+    // repeat the end values).
+    const int64_t* q = keys[k].q + std::max<int64_t>(first - 2, 0);
+    const int64_t* q_end = keys[k].q + std::min(last + 1, keys[k].n - 1) + 1;
+    int64_t lo = *q, hi = *q;
+    for (; q < q_end; ++q) lo = std::min(lo, *q), hi = std::max(hi, *q);
+    r.base[k] = static_cast<uint64_t>(lo - cv[k].q_base);
+    r.value_bits[k] = bit_width(static_cast<uint64_t>(hi - lo));
+    bits += cv[k].base_bits + uint64_t(last - first + kContextKeys) * r.value_bits[k];
+  }
+  const Keys& f = keys[0];  // the curves' frames are the same
   const int64_t end = start + kBlockFrames;
-  const uint64_t context = zigzag(keys.frame(first - 2) - start) | zigzag(keys.frame(first - 1) - start) |
-                           zigzag(keys.frame(last) - end) | zigzag(keys.frame(last + 1) - end);
+  const uint64_t context = zigzag(f.frame(first - 2) - start) | zigzag(f.frame(first - 1) - start) |
+                           zigzag(f.frame(last) - end) | zigzag(f.frame(last + 1) - end);
   r.context_bits = bit_width(context);
-  const uint64_t bits = kRecordBitsAt + kContextKeys * uint64_t(r.context_bits) + base_bits +
-                        uint64_t(last - first + kContextKeys) * r.value_bits;
+  bits += kContextKeys * uint64_t(r.context_bits);
   r.size_bytes = (bits + 7) / 8;
   return r;
 }
@@ -81,26 +89,31 @@ class BitWriter {
   uint64_t bit_ = 0;
 };
 
-void write_record(uint8_t* out, const Keys& keys, const RecordPlan& r, int64_t start, int64_t q_base,
-                  uint32_t base_bits) {
+void write_record(uint8_t* out, const Keys* keys, const Curve* cv, const RecordPlan& r, int64_t start) {
+  const Keys& f = keys[0];
   uint64_t mask = 0;
-  for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (keys.k[i] - start);
+  for (int64_t i = r.first; i < r.last; ++i) mask |= uint64_t(1) << (f.k[i] - start);
   std::memcpy(out, &mask, 8);
-  out[8] = static_cast<uint8_t>(r.value_bits);
-  out[9] = static_cast<uint8_t>(r.context_bits);
-  BitWriter w(out + kRecordBitsAt / 8);
+  for (uint32_t k = 0; k < r.curves; ++k) out[8 + k] = static_cast<uint8_t>(r.value_bits[k]);
+  const uint32_t header = r.curves == 1 ? kRecordBitsAt : kTrackRecordBitsAt;
+  out[header / 8 - 1] = static_cast<uint8_t>(r.context_bits);
+  BitWriter w(out + header / 8);
   const int64_t end = start + kBlockFrames;
-  w.put(zigzag(keys.frame(r.first - 2) - start), r.context_bits);
-  w.put(zigzag(keys.frame(r.first - 1) - start), r.context_bits);
-  w.put(zigzag(keys.frame(r.last) - end), r.context_bits);
-  w.put(zigzag(keys.frame(r.last + 1) - end), r.context_bits);
-  w.put(r.base, base_bits);
-  const uint64_t low = static_cast<uint64_t>(q_base) + r.base;
-  const int64_t inner_first = std::max<int64_t>(r.first - 2, 0), inner_last = std::min(r.last + 1, keys.n - 1);
-  for (int64_t i = r.first - 2; i < inner_first; ++i) w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
-  for (int64_t i = inner_first; i <= inner_last; ++i) w.put(static_cast<uint64_t>(keys.q[i]) - low, r.value_bits);
-  for (int64_t i = std::max(inner_last + 1, r.first - 2); i <= r.last + 1; ++i)
-    w.put(static_cast<uint64_t>(keys.value(i)) - low, r.value_bits);
+  w.put(zigzag(f.frame(r.first - 2) - start), r.context_bits);
+  w.put(zigzag(f.frame(r.first - 1) - start), r.context_bits);
+  w.put(zigzag(f.frame(r.last) - end), r.context_bits);
+  w.put(zigzag(f.frame(r.last + 1) - end), r.context_bits);
+  for (uint32_t k = 0; k < r.curves; ++k) w.put(r.base[k], cv[k].base_bits);
+  for (uint32_t k = 0; k < r.curves; ++k) {
+    const Keys& keys_k = keys[k];
+    const uint64_t low = static_cast<uint64_t>(cv[k].q_base) + r.base[k];
+    const uint32_t vw = r.value_bits[k];
+    const int64_t inner_first = std::max<int64_t>(r.first - 2, 0), inner_last = std::min(r.last + 1, keys_k.n - 1);
+    for (int64_t i = r.first - 2; i < inner_first; ++i) w.put(static_cast<uint64_t>(keys_k.value(i)) - low, vw);
+    for (int64_t i = inner_first; i <= inner_last; ++i) w.put(static_cast<uint64_t>(keys_k.q[i]) - low, vw);
+    for (int64_t i = std::max(inner_last + 1, r.first - 2); i <= r.last + 1; ++i)
+      w.put(static_cast<uint64_t>(keys_k.value(i)) - low, vw);
+  }
 }
 
 // The image's arrays as build_image fills them, before they are written as IMAG (Image's
@@ -119,6 +132,10 @@ struct Arrays {
   std::vector<int64_t> list_q;
   std::vector<float> curve_s, first_frame, last_frame, first_value, last_value;
   std::vector<uint32_t> curve_linear, curve_channel;
+  std::vector<uint32_t> quat_node, quat_column;
+  std::vector<float> quat_reference;  // 4 x lanes(Q): x's, y's, z's, w's
+  std::vector<uint32_t> track_first;  // with quaternion nodes only
+  uint32_t block_tracks = 0;
   uint32_t block_count = 0;
   std::vector<uint32_t> record_offset;
   std::vector<uint8_t> payload;  // records, then kPayloadPadding zero bytes
@@ -132,12 +149,16 @@ void put_array(uint8_t* imag, const ImageLayout& at, ImageLayout::Array a, const
 // IMAG's bytes (spec section 9.2) in a zeroed, 8-aligned buffer, and the image pointed into it.
 void write_imag(const Arrays& a, Image& img) {
   const ImageCounts n{a.interp.size(), a.curves.size(), a.block_curves, a.block_count, a.list_frames.size(),
-                      a.payload.size() - kPayloadPadding};
+                      a.payload.size() - kPayloadPadding, a.quat_node.size(), a.block_tracks};
   const ImageLayout at(n);
   auto words = std::make_shared<uint64_t[]>(at.end() / 8);
   uint8_t* imag = reinterpret_cast<uint8_t*>(words.get());
-  const uint32_t header[6] = {kBlockShift, uint32_t(n.curves), uint32_t(n.block_curves), uint32_t(n.blocks),
-                              uint32_t(n.list_keys), uint32_t(n.payload)};
+  // Version 5's Quat_Count and Block_Track_Count; version 4's Image_Reserved (0) without
+  // quaternion nodes.
+  const bool v5 = n.quat_nodes > 0;
+  const uint32_t header[8] = {kBlockShift, uint32_t(n.curves), uint32_t(n.block_curves), uint32_t(n.blocks),
+                              uint32_t(n.list_keys), uint32_t(n.payload), uint32_t(n.quat_nodes),
+                              v5 ? uint32_t(n.block_tracks) : 0u};
   std::memcpy(imag, header, sizeof header);
   using L = ImageLayout;
   put_array(imag, at, L::interpolation, a.interp);
@@ -160,6 +181,10 @@ void write_imag(const Arrays& a, Image& img) {
   put_array(imag, at, L::last_value, a.last_value);
   put_array(imag, at, L::curve_linear, a.curve_linear);
   put_array(imag, at, L::curve_channel, a.curve_channel);
+  put_array(imag, at, L::quat_node, a.quat_node);
+  put_array(imag, at, L::quat_column, a.quat_column);
+  put_array(imag, at, L::quat_reference, a.quat_reference);
+  put_array(imag, at, L::track_first, a.track_first);
   put_array(imag, at, L::lists, a.lists);
   put_array(imag, at, L::list_frames, a.list_frames);
   put_array(imag, at, L::list_values, a.list_values);
@@ -176,7 +201,18 @@ void write_imag(const Arrays& a, Image& img) {
 // The motion: IMAG's bytes (owned, or viewed: the clip needs them resident either way), notes,
 // and the image itself.
 size_t Image::animation_bytes() const noexcept {
-  return sizeof(Image) + notes.capacity() + std::max(held_bytes, imag.size());
+  return sizeof(Image) + notes.capacity() + std::max(held_bytes, imag.size()) + own_euler.bytes();
+}
+
+void plan_rotations(Image& img) {
+  if (img.quat_node.empty()) {
+    img.euler = &img.rig->euler;
+    return;
+  }
+  std::vector<uint8_t> quat(img.rig->skeleton.joints.size(), 0);
+  for (uint32_t n : img.quat_node) quat[n] = 1;
+  img.own_euler = euler_groups(img.rig->skeleton, &quat);
+  img.euler = &img.own_euler;
 }
 
 template <class T>
@@ -186,9 +222,17 @@ std::span<const T> array_at(std::span<const uint8_t> imag, const ImageLayout& at
 }
 
 ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept {
-  uint32_t h[6];
+  uint32_t h[8];
   std::memcpy(h, imag.data(), sizeof h);
-  return {channels, h[1], h[2], h[3], h[4], h[5]};
+  return {channels, h[1], h[2], h[3], h[4], h[5], h[6], h[6] > 0 ? h[7] : h[2]};
+}
+
+Image::TrackOf Image::track_of(uint32_t curve) const noexcept {
+  if (track_first.empty()) return {curve, 0, 1};
+  const uint32_t t = static_cast<uint32_t>(std::upper_bound(track_first.begin(), track_first.end(), curve) -
+                                           track_first.begin()) - 1;
+  const uint32_t next = t + 1 < block_tracks ? track_first[t + 1] : block_curves;
+  return {t, curve - track_first[t], next - track_first[t]};
 }
 
 void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) noexcept {
@@ -217,12 +261,59 @@ void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) 
   img.last_value = array_at<float>(imag, at, L::last_value, lanes);
   img.curve_linear = array_at<uint32_t>(imag, at, L::curve_linear, lanes);
   img.curve_channel = array_at<uint32_t>(imag, at, L::curve_channel, n.curves);
+  img.quat_node = array_at<uint32_t>(imag, at, L::quat_node, n.quat_nodes);
+  img.quat_column = array_at<uint32_t>(imag, at, L::quat_column, n.quat_nodes);
+  img.quat_lanes = static_cast<uint32_t>(L::lanes(n.quat_nodes));
+  img.quat_reference = array_at<float>(imag, at, L::quat_reference, 4 * uint64_t(img.quat_lanes));
+  img.track_first = array_at<uint32_t>(imag, at, L::track_first, n.quat_nodes > 0 ? n.block_tracks : 0);
+  img.block_tracks = static_cast<uint32_t>(n.block_tracks);
   img.block_count = static_cast<uint32_t>(n.blocks);
-  img.record_offset = array_at<uint32_t>(imag, at, L::record_offset, n.blocks * n.block_curves + kPrefetchRecords);
+  img.record_offset = array_at<uint32_t>(imag, at, L::record_offset, n.blocks * n.block_tracks + kPrefetchRecords);
   img.payload = array_at<uint8_t>(imag, at, L::payload, n.payload + kPayloadPadding);
 }
 
 namespace {
+
+// The quaternion nodes' arrays (node, x's column, references in lanes) and the block tracks: a
+// quaternion node's three block curves (consecutive: its channels are, and block curves are in
+// channel order) make one track, any other block curve one of its own.
+void add_quat_arrays(const ClipSource& src, Arrays& a) {
+  const size_t q = src.quat_nodes.size();
+  const size_t lanes = ImageLayout::lanes(q);
+  a.quat_reference.assign(4 * lanes, 0.0f);
+  for (size_t i = q; i < lanes; ++i) a.quat_reference[3 * lanes + i] = 1.0f;  // the identity
+  for (size_t i = 0; i < q; ++i) {
+    const QuatNode& n = src.quat_nodes[i];
+    a.quat_node.push_back(n.node);
+    a.quat_column.push_back(quat_column(src.skeleton, n.node));
+    for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = n.reference[k];
+  }
+  const std::vector<Stored> kinds = stored_kinds(src.skeleton, src.quat_nodes);
+  a.block_tracks = 0;
+  for (uint32_t i = 0; i < a.block_curves; ++a.block_tracks) {
+    if (q > 0) a.track_first.push_back(i);
+    i += kinds[a.curve_channel[i]] == Stored::quat_x ? kTrackCurves : 1;
+  }
+}
+
+// Track t's curves: their Keys and Curve facts.
+struct TrackCurves {
+  uint32_t curves = 1;
+  Keys keys[kTrackCurves];
+  Curve cv[kTrackCurves];
+};
+TrackCurves track_curves(const ClipSource& src, const Arrays& a, size_t t) {
+  TrackCurves tc;
+  const uint32_t first = a.track_first.empty() ? uint32_t(t) : a.track_first[t];
+  const uint32_t next = a.track_first.empty() || t + 1 == a.track_first.size() ? a.block_curves : a.track_first[t + 1];
+  tc.curves = a.track_first.empty() ? 1 : next - first;
+  for (uint32_t k = 0; k < tc.curves; ++k) {
+    const SourceChannel& sc = src.channels[a.curve_channel[first + k]];
+    tc.keys[k] = {src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
+    tc.cv[k] = a.curves[first + k];
+  }
+  return tc;
+}
 
 // The image's arrays from a source's keys: two passes over every curve, the first sizing each
 // record (its widths depend on the values in its window), the second writing it at its place.
@@ -293,20 +384,20 @@ Arrays build_arrays(const ClipSource& src) {
   a.last_value.resize(lanes, 0.0f);
   a.curve_linear.resize(lanes, 0u);
   a.block_count = nc == 0 ? 0 : static_cast<uint32_t>(blocks);
-  const size_t nb = a.block_curves;  // records: at most 4 per key of a block curve
-  const size_t records = size_t(a.block_count) * nb;
+  add_quat_arrays(src, a);
+  const size_t nt = a.block_tracks;  // records: at most 4 per key of a block curve
+  const size_t records = size_t(a.block_count) * nt;
   std::vector<RecordPlan> plans(records);
-  for (size_t i = 0; i < nb; ++i) {
-    const Curve& cv = a.curves[i];
-    const SourceChannel& sc = src.channels[a.curve_channel[i]];
-    const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
+  for (size_t t = 0; t < nt; ++t) {
+    const TrackCurves tc = track_curves(src, a, t);
     int64_t first = 0, last = 0;  // the block's keys: [first, last)
+    const Keys& keys = tc.keys[0];  // the track's key frames
     for (uint32_t b = 0; b < a.block_count; ++b) {
       const int64_t start = int64_t(b) << kBlockShift;
       while (first < keys.n && int64_t(keys.k[first]) < start) ++first;
       last = std::max(last, first);
       while (last < keys.n && int64_t(keys.k[last]) < start + kBlockFrames) ++last;
-      plans[size_t(b) * nb + i] = plan_record(keys, first, last, start, cv.q_base, cv.base_bits);
+      plans[size_t(b) * nt + t] = plan_record(tc.keys, tc.cv, tc.curves, first, last, start);
       first = last;  // the next block's keys start where this block's end
     }
   }
@@ -320,14 +411,11 @@ Arrays build_arrays(const ClipSource& src) {
     total += plans[r].size_bytes;
   }
   a.payload.assign(total + kPayloadPadding, 0);
-  for (size_t i = 0; i < nb; ++i) {
-    const Curve& cv = a.curves[i];
-    const SourceChannel& sc = src.channels[a.curve_channel[i]];
-    const Keys keys{src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
+  for (size_t t = 0; t < nt; ++t) {
+    const TrackCurves tc = track_curves(src, a, t);
     for (uint32_t b = 0; b < a.block_count; ++b) {
-      const size_t r = size_t(b) * nb + i;
-      write_record(a.payload.data() + a.record_offset[r], keys, plans[r], int64_t(b) << kBlockShift,
-                   cv.q_base, cv.base_bits);
+      const size_t r = size_t(b) * nt + t;
+      write_record(a.payload.data() + a.record_offset[r], tc.keys, tc.cv, plans[r], int64_t(b) << kBlockShift);
     }
   }
   return a;
@@ -359,6 +447,7 @@ std::shared_ptr<const Image> build_image(ClipSource&& src, RigCache* rigs) {
   std::shared_ptr<Image> img = image_of(src, rigs);
   img->total_keys = keys;
   write_imag(a, *img);
+  plan_rotations(*img);
   return img;
 }
 
@@ -374,6 +463,7 @@ std::shared_ptr<const Image> view_image(ClipSource&& facts, uint64_t total_keys,
   img->held_bytes = held_bytes;
   img->runtime_profile = true;
   attach_image(*img, imag, channels);
+  plan_rotations(*img);
   return img;
 }
 

@@ -25,16 +25,13 @@ void single_key(float v, int64_t& q, double& step) noexcept {
 void block_curve_keys(const Image& img, uint32_t curve, ClipSource& out) {
   const Curve& cv = img.curves[curve];
   for (uint32_t b = 0; b < img.block_count; ++b) {
-    const uint8_t* rec = img.record(b, curve);
-    uint64_t mask;
-    std::memcpy(&mask, rec, 8);
-    const uint32_t vw = rec[8], kw = rec[9];
-    const uint64_t base_at = kRecordBitsAt + uint64_t(kContextKeys) * kw;
-    const int64_t low = cv.q_base + static_cast<int64_t>(read_bits(rec, base_at, cv.base_bits));
-    uint64_t at = base_at + cv.base_bits + 2ull * vw;  // Values[2]: the block's first key
-    for (; mask != 0; mask &= mask - 1, at += vw) {
+    CurveFields f;
+    const uint8_t* rec = curve_record(img, b, curve, f);
+    const int64_t low = cv.q_base + static_cast<int64_t>(read_bits(rec, f.base_at, cv.base_bits));
+    uint64_t at = f.values_at + 2ull * f.value_bits;  // Values[2]: the block's first key
+    for (uint64_t mask = f.mask; mask != 0; mask &= mask - 1, at += f.value_bits) {
       out.frames.push_back((b << kBlockShift) + static_cast<uint32_t>(low_bit(mask)));
-      out.q.push_back(low + static_cast<int64_t>(read_bits(rec, at, vw)));
+      out.q.push_back(low + static_cast<int64_t>(read_bits(rec, at, f.value_bits)));
     }
   }
 }
@@ -50,6 +47,11 @@ ClipSource image_keys(const Image& img) {
   src.rule = img.rule;
   src.skeleton = img.rig->skeleton;
   src.notes = img.notes;
+  src.quat_nodes.resize(img.quat_node.size());
+  for (size_t i = 0; i < src.quat_nodes.size(); ++i) {
+    src.quat_nodes[i].node = img.quat_node[i];
+    for (size_t k = 0; k < 4; ++k) src.quat_nodes[i].reference[k] = img.quat_reference[k * img.quat_lanes + i];
+  }
   src.channels.resize(img.interp.size());
   src.frames.reserve(static_cast<size_t>(img.total_keys));
   src.q.reserve(static_cast<size_t>(img.total_keys));

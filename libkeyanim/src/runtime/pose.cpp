@@ -1,7 +1,9 @@
-// Euler channels to quaternions, translations, and forward kinematics in binary32. The rules
-// are those of spec/FORMAT.md Appendix B (the encoder's forward kinematics): a node's rotation
-// is the product of its rotation channels in their order (intrinsic), R = R_1 R_2 R_3; as
-// quaternions q = q_1 q_2 q_3 with q_axis(a) = (sin(a/2) axis, cos(a/2)).
+// Stored values to quaternions, translations, and forward kinematics in binary32. The rules
+// are those of spec/FORMAT.md Appendix B (the encoder's forward kinematics): an Euler node's
+// rotation is the product of its rotation channels in their order (intrinsic), R = R_1 R_2
+// R_3; as quaternions q = q_1 q_2 q_3 with q_axis(a) = (sin(a/2) axis, cos(a/2)). A quaternion
+// node's (version 5) is its reference times (x, y, z, w), w rebuilt, normalized
+// (keyanim/rotation.h's stored_rotation, 4 or 8 nodes a register).
 #include "runtime/pose.h"
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include "internal/cpu.h"
 #include "internal/prefetch.h"
 #include "internal/trig.h"
+#include "keyanim/rotation.h"
 
 namespace keyanim::internal {
 namespace {
@@ -37,16 +40,16 @@ KEYANIM_INLINE inline QuatLanes<V> rotate_by(const QuatLanes<V>& q, uint32_t axi
   }
 }
 
-// The angles of `lanes` nodes (the rest 0) from their columns, gathered into registers (the
-// first parameter only picks the register type: F4 or F8).
-KEYANIM_INLINE inline F4 gather_angles(const F4*, const float* values, const uint32_t* column, uint32_t column0,
-                                       uint32_t lanes) noexcept {
+// The values of `lanes` nodes (the rest 0) at their columns, values[column[l] - column0],
+// gathered into registers (the first parameter only picks the register type: F4 or F8).
+KEYANIM_INLINE inline F4 gather_lanes(const F4*, const float* values, const uint32_t* column, uint32_t column0,
+                                      uint32_t lanes) noexcept {
   auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
   return F4::set(angle(0), angle(1), angle(2), angle(3));
 }
 #if KEYANIM_WIDE_LANES
-KEYANIM_INLINE inline F8 gather_angles(const F8*, const float* values, const uint32_t* column, uint32_t column0,
-                                       uint32_t lanes) noexcept {
+KEYANIM_INLINE inline F8 gather_lanes(const F8*, const float* values, const uint32_t* column, uint32_t column0,
+                                      uint32_t lanes) noexcept {
   auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
   return F8(V8f{angle(0), angle(1), angle(2), angle(3), angle(4), angle(5), angle(6), angle(7)});
 }
@@ -70,35 +73,72 @@ KEYANIM_INLINE inline void store_rotations(const QuatLanes<F8>& q, const uint32_
 
 // The rotations of `lanes` nodes of a group from its node i, in the registers of one V.
 template <class V>
-KEYANIM_INLINE inline void lane_rotations(const Rig& rig, const Rig::RotationGroup& g, uint32_t i, uint32_t lanes,
+KEYANIM_INLINE inline void lane_rotations(const EulerGroups& eg, const EulerGroups::Group& g, uint32_t i, uint32_t lanes,
                                           const float* values, uint32_t column0, uint32_t first,
                                           Transform* out) noexcept {
   QuatLanes<V> q{V(0.0f), V(0.0f), V(0.0f), V(1.0f)};
   for (uint32_t k = 0; k < g.steps; ++k) {
-    const uint32_t* column = rig.group_column.data() + g.column_first + size_t(k) * g.node_count + i;
+    const uint32_t* column = eg.column.data() + g.column_first + size_t(k) * g.node_count + i;
     V s, c;
-    half_sincos_deg(gather_angles(static_cast<const V*>(nullptr), values, column, column0, lanes), s, c);
+    half_sincos_deg(gather_lanes(static_cast<const V*>(nullptr), values, column, column0, lanes), s, c);
     q = rotate_by(q, g.axis[k], s, c);
   }
-  store_rotations(q, rig.group_node.data() + g.node_first + i, first, lanes, out);
+  store_rotations(q, eg.node.data() + g.node_first + i, first, lanes, out);
 }
 
 // The rotations of a group's nodes [begin, end) (indices into the group), out[node - first]:
 // 8 at a time when kWide while more than 4 are left, then 4.
 template <bool kWide>
-KEYANIM_INLINE inline void group_rotations(const Rig& rig, const Rig::RotationGroup& g, uint32_t begin, uint32_t end,
-                                           const float* values, uint32_t column0, uint32_t first,
+KEYANIM_INLINE inline void group_rotations(const EulerGroups& eg, const EulerGroups::Group& g, uint32_t begin,
+                                           uint32_t end, const float* values, uint32_t column0, uint32_t first,
                                            Transform* out) noexcept {
   for (uint32_t i = begin; i < end;) {
     const uint32_t left = end - i;
 #if KEYANIM_WIDE_LANES
     if (kWide && left > 4) {
-      lane_rotations<F8>(rig, g, i, std::min(8u, left), values, column0, first, out);
+      lane_rotations<F8>(eg, g, i, std::min(8u, left), values, column0, first, out);
       i += 8;
       continue;
     }
 #endif
-    lane_rotations<F4>(rig, g, i, std::min(4u, left), values, column0, first, out);
+    lane_rotations<F4>(eg, g, i, std::min(4u, left), values, column0, first, out);
+    i += 4;
+  }
+}
+
+// Quaternion nodes i .. i + lanes - 1 (of the image's, lanes <= V's) from their stored x, y, z:
+// stored_rotation in every lane. Padding lanes read zeros and the identity reference.
+template <class V>
+KEYANIM_INLINE inline void quat_lane_rotations(const Image& img, uint32_t i, uint32_t lanes, const float* values,
+                                               uint32_t column0, uint32_t first, Transform* out) noexcept {
+  const uint32_t* column = img.quat_column.data() + i;
+  V xyz[3];
+  for (uint32_t k = 0; k < 3; ++k)  // column[l] + k's value: unsigned, column[l] - (column0 - k) is that
+    xyz[k] = gather_lanes(static_cast<const V*>(nullptr), values, column, column0 - k, lanes);
+  const float* ref = img.quat_reference.data() + i;
+  const V r[4] = {V::load(ref), V::load(ref + img.quat_lanes), V::load(ref + 2 * size_t(img.quat_lanes)),
+                  V::load(ref + 3 * size_t(img.quat_lanes))};
+  V q[4];
+  stored_rotation<V>(r, xyz[0], xyz[1], xyz[2], q, [](V x) KEYANIM_INLINE { return sqrt_lanes(x); },
+                     [](V x) KEYANIM_INLINE { return max0(x); });
+  store_rotations(QuatLanes<V>{q[0], q[1], q[2], q[3]}, img.quat_node.data() + i, first, lanes, out);
+}
+
+// The rotations of the image's quaternion nodes [begin, end) (indices into its quaternion
+// arrays), out[node - first]: 8 at a time when kWide while more than 4 are left, then 4.
+template <bool kWide>
+KEYANIM_INLINE inline void quat_rotations(const Image& img, uint32_t begin, uint32_t end, const float* values,
+                                          uint32_t column0, uint32_t first, Transform* out) noexcept {
+  for (uint32_t i = begin; i < end;) {
+    const uint32_t left = end - i;
+#if KEYANIM_WIDE_LANES
+    if (kWide && left > 4) {
+      quat_lane_rotations<F8>(img, i, std::min(8u, left), values, column0, first, out);
+      i += 8;
+      continue;
+    }
+#endif
+    quat_lane_rotations<F4>(img, i, std::min(4u, left), values, column0, first, out);
     i += 4;
   }
 }
@@ -177,12 +217,18 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
     t = reading == PositionReading::add ? rig.node_offset[4 * size_t(m->node) + m->axis] + v : v;
   }
   // Rotations, group by group: the group's nodes in [first, last).
-  for (const Rig::RotationGroup& g : rig.rot_groups) {
-    const uint32_t* node = rig.group_node.data() + g.node_first;
+  const EulerGroups& eg = *img.euler;
+  for (const EulerGroups::Group& g : eg.groups) {
+    const uint32_t* node = eg.node.data() + g.node_first;
     const uint32_t begin = whole ? 0 : lower_index(node, g.node_count, first);
     const uint32_t end = whole ? g.node_count : lower_index(node, g.node_count, last);
-    group_rotations<kWide>(rig, g, begin, end, values, column0, first, out);
+    group_rotations<kWide>(eg, g, begin, end, values, column0, first, out);
   }
+  const uint32_t quats = static_cast<uint32_t>(img.quat_node.size());
+  if (quats == 0) return;
+  const uint32_t begin = whole ? 0 : lower_index(img.quat_node.data(), quats, first);
+  const uint32_t end = whole ? quats : lower_index(img.quat_node.data(), quats, last);
+  quat_rotations<kWide>(img, begin, end, values, column0, first, out);
 }
 
 KEYANIM_INLINE inline void compose_impl(const Image& img, Transform* out) noexcept {
@@ -231,9 +277,9 @@ void local_transforms(const Image& img, uint32_t first, uint32_t last, const flo
 
 void prefetch_pose_tables(const Image& img, Transform* out, uint32_t nodes) noexcept {
   const Rig& rig = *img.rig;
-  prefetch_array(rig.rot_groups.data(), rig.rot_groups.size());
-  prefetch_array(rig.group_column.data(), rig.group_column.size());
-  prefetch_array(rig.group_node.data(), rig.group_node.size());
+  prefetch_array(img.euler->groups.data(), img.euler->groups.size());
+  prefetch_array(img.euler->column.data(), img.euler->column.size());
+  prefetch_array(img.euler->node.data(), img.euler->node.size());
   prefetch_array(rig.node_offset.data(), rig.node_offset.size());
   prefetch_array(rig.moves.data(), rig.moves.size());
   prefetch_array<true>(out, nodes);

@@ -26,48 +26,18 @@ struct Fnv {
   void u64(uint64_t x) noexcept { bytes(&x, sizeof x); }  // little-endian hosts, as the loader
 };
 
-// The pose tables (Rig::node_offset, rot_groups, moves): nodes grouped by their rotation
-// axes in order of first appearance, each group's columns step by step.
+// The pose tables (Rig::node_offset, moves; the Euler groups: euler_groups).
 void build_pose_tables(Rig& rig) {
-  std::vector<std::vector<uint32_t>> members;  // per group, its nodes
-  std::unordered_map<uint32_t, uint32_t> group_of;
   const auto& joints = rig.skeleton.joints;
   for (uint32_t node = 0; node < joints.size(); ++node) {
     const Joint& j = joints[node];
     for (double o : j.offset) rig.node_offset.push_back(static_cast<float>(o));
     rig.node_offset.push_back(0.0f);
-    Rig::RotationGroup key{};
-    for (size_t k = 0; k < j.channels.size(); ++k) {
-      const uint32_t column = j.first_channel + static_cast<uint32_t>(k);
-      const uint32_t axis = static_cast<uint32_t>(channel_axis(j.channels[k]));
-      if (is_rotation(j.channels[k]))
-        key.axis[key.steps++] = static_cast<uint8_t>(axis);
-      else
-        rig.moves.push_back({node, column, axis});
-    }
-    uint32_t code = key.steps;  // the axis sequence as a number: one lookup per node
-    for (uint32_t k = 0; k < key.steps; ++k) code = code * 3 + key.axis[k];
-    const auto [at, added] = group_of.try_emplace(code, static_cast<uint32_t>(rig.rot_groups.size()));
-    if (added) {
-      rig.rot_groups.push_back(key);
-      members.emplace_back();
-    }
-    members[at->second].push_back(node);
+    for (size_t k = 0; k < j.channels.size(); ++k)
+      if (!is_rotation(j.channels[k]))
+        rig.moves.push_back({node, j.first_channel + static_cast<uint32_t>(k), static_cast<uint32_t>(channel_axis(j.channels[k]))});
   }
-  for (size_t i = 0; i < rig.rot_groups.size(); ++i) {
-    Rig::RotationGroup& g = rig.rot_groups[i];
-    g.node_first = static_cast<uint32_t>(rig.group_node.size());
-    g.node_count = static_cast<uint32_t>(members[i].size());
-    g.column_first = static_cast<uint32_t>(rig.group_column.size());
-    rig.group_node.insert(rig.group_node.end(), members[i].begin(), members[i].end());
-    for (uint32_t k = 0; k < g.steps; ++k)
-      for (uint32_t node : members[i]) {
-        const Joint& j = joints[node];
-        uint32_t seen = 0;  // the node's k-th rotation channel
-        for (size_t c = 0; c < j.channels.size(); ++c)
-          if (is_rotation(j.channels[c]) && seen++ == k) rig.group_column.push_back(j.first_channel + uint32_t(c));
-      }
-  }
+  rig.euler = euler_groups(rig.skeleton);
 }
 
 // The skeleton's nodes: the array, names beyond the small-string buffer, channel lists.
@@ -84,13 +54,54 @@ void shrink(Rig& rig) {
   rig.skeleton.joints.shrink_to_fit();
   for (Joint& j : rig.skeleton.joints) j.name.shrink_to_fit(), j.channels.shrink_to_fit();
   rig.node_offset.shrink_to_fit();
-  rig.rot_groups.shrink_to_fit();
-  rig.group_node.shrink_to_fit();
-  rig.group_column.shrink_to_fit();
   rig.moves.shrink_to_fit();
 }
 
 }  // namespace
+
+// Nodes grouped by their rotation axes in order of first appearance, each group's columns step
+// by step.
+EulerGroups euler_groups(const Skeleton& skeleton, const std::vector<uint8_t>* skip) {
+  EulerGroups out;
+  std::vector<std::vector<uint32_t>> members;  // per group, its nodes
+  std::unordered_map<uint32_t, uint32_t> group_of;
+  const auto& joints = skeleton.joints;
+  for (uint32_t node = 0; node < joints.size(); ++node) {
+    if (skip != nullptr && (*skip)[node]) continue;
+    const Joint& j = joints[node];
+    EulerGroups::Group key{};
+    for (size_t k = 0; k < j.channels.size(); ++k)
+      if (is_rotation(j.channels[k])) key.axis[key.steps++] = static_cast<uint8_t>(channel_axis(j.channels[k]));
+    uint32_t code = key.steps;  // the axis sequence as a number: one lookup per node
+    for (uint32_t k = 0; k < key.steps; ++k) code = code * 3 + key.axis[k];
+    const auto [at, added] = group_of.try_emplace(code, static_cast<uint32_t>(out.groups.size()));
+    if (added) {
+      out.groups.push_back(key);
+      members.emplace_back();
+    }
+    members[at->second].push_back(node);
+  }
+  for (size_t i = 0; i < out.groups.size(); ++i) {
+    EulerGroups::Group& g = out.groups[i];
+    g.node_first = static_cast<uint32_t>(out.node.size());
+    g.node_count = static_cast<uint32_t>(members[i].size());
+    g.column_first = static_cast<uint32_t>(out.column.size());
+    out.node.insert(out.node.end(), members[i].begin(), members[i].end());
+    for (uint32_t k = 0; k < g.steps; ++k)
+      for (uint32_t node : members[i]) {
+        const Joint& j = joints[node];
+        uint32_t seen = 0;  // the node's k-th rotation channel
+        for (size_t c = 0; c < j.channels.size(); ++c)
+          if (is_rotation(j.channels[c]) && seen++ == k) out.column.push_back(j.first_channel + uint32_t(c));
+      }
+  }
+  out.groups.shrink_to_fit(), out.node.shrink_to_fit(), out.column.shrink_to_fit();
+  return out;
+}
+
+size_t EulerGroups::bytes() const noexcept {
+  return groups.capacity() * sizeof(Group) + (node.capacity() + column.capacity()) * sizeof(uint32_t);
+}
 
 uint64_t rig_hash(const Skeleton& skeleton) noexcept {
   Fnv f;
@@ -117,9 +128,8 @@ bool same_rig(const Skeleton& a, const Skeleton& b) noexcept {
 
 // The skeleton's nodes, the pose tables and the rig itself.
 size_t Rig::bytes() const noexcept {
-  return sizeof(Rig) + joints_bytes(skeleton) + node_offset.capacity() * sizeof(float) +
-         rot_groups.capacity() * sizeof(RotationGroup) +
-         (group_node.capacity() + group_column.capacity()) * sizeof(uint32_t) + moves.capacity() * sizeof(Move);
+  return sizeof(Rig) + joints_bytes(skeleton) + node_offset.capacity() * sizeof(float) + euler.bytes() +
+         moves.capacity() * sizeof(Move);
 }
 
 std::shared_ptr<const Rig> make_rig(Skeleton&& skeleton) {

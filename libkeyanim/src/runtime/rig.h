@@ -12,27 +12,36 @@
 
 namespace keyanim::internal {
 
+// Nodes whose rotation is their Euler channels, grouped by the axes of those channels in order
+// (Z X Y for most BVH joints, none for End Sites), so that 4 or 8 nodes of a group become
+// quaternions in one register per component, one step per channel (pose.cpp).
+struct EulerGroups {
+  struct Group {
+    uint32_t node_first, node_count;  // its nodes: node[node_first ..), in increasing order
+    uint32_t column_first;            // step k's columns: column[column_first + k * node_count ..)
+    uint32_t steps;                   // rotation channels per node (<= kMaxNodeChannels)
+    uint8_t axis[kMaxNodeChannels];   // their axes in composition order: 0 X, 1 Y, 2 Z
+  };
+  std::vector<Group> groups;
+  std::vector<uint32_t> node, column;
+  size_t bytes() const noexcept;
+};
+// The groups of `skeleton`'s nodes, but those whose `skip` entry is set (none when null).
+EulerGroups euler_groups(const Skeleton& skeleton, const std::vector<uint8_t>* skip = nullptr);
+
 struct Rig {
   Skeleton skeleton;
   uint64_t hash = 0;  // rig_hash(skeleton)
   // Poses (pose.cpp). node_offset: 4 per node, its OFFSET in binary32 and a 0 (Transform's
-  // translation and reserved, one copy). Rotations: nodes are grouped by the axes of their
-  // rotation channels in order (Z X Y for most BVH joints, none for End Sites), so that 4 nodes
-  // of a group become quaternions in one register per component, one step per channel.
-  // Positions: every position channel, in node order.
-  struct RotationGroup {
-    uint32_t node_first, node_count;  // its nodes: group_node[node_first ..), in increasing order
-    uint32_t column_first;            // step k's columns: group_column[column_first + k * node_count ..)
-    uint32_t steps;                   // rotation channels per node (<= kMaxNodeChannels)
-    uint8_t axis[kMaxNodeChannels];   // their axes in composition order: 0 X, 1 Y, 2 Z
-  };
+  // translation and reserved, one copy). Rotations: every node's Euler channels (a clip that
+  // stores some nodes as quaternions has its own groups: Image::euler). Positions: every
+  // position channel, in node order.
   struct Move {
     uint32_t node, column;
     uint32_t axis;  // 0 X, 1 Y, 2 Z
   };
   std::vector<float> node_offset;
-  std::vector<RotationGroup> rot_groups;
-  std::vector<uint32_t> group_node, group_column;
+  EulerGroups euler;
   std::vector<Move> moves;
 
   size_t bytes() const noexcept;  // everything the rig holds, itself included

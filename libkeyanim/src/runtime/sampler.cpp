@@ -101,24 +101,75 @@ Position position(const Image& img, float f) noexcept {
 // The image's arrays for one block, loaded once per pose rather than once per curve.
 struct BlockView {
   const uint8_t* payload;
-  const uint32_t* offsets;  // the block's row of record offsets
+  const uint32_t* offsets;  // the block's row of record offsets, one per track
   const Curve* curves;
   uint64_t upto;            // frames_upto(t): the block's keys at or before the position
 };
 
 BlockView block_view(const Image& img, const Position& at) noexcept {
-  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_curves, img.curves.data(),
+  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_tracks, img.curves.data(),
           frames_upto(at.t)};
 }
 
+// Block curve `curve` alone in track `track`'s record into lane i.
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t curve, Batch& b, uint32_t i) noexcept {
+[[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t track, uint32_t curve, Batch& b,
+                                          uint32_t i) noexcept {
   const Curve& cv = v.curves[curve];
-  const uint8_t* rec = v.payload + v.offsets[curve];
+  const uint8_t* rec = v.payload + v.offsets[track];
   Window w;
   read_window<kPopcnt>(rec, cv.base_bits, v.upto, w);
   std::memcpy(b.frames[i], w.frame, sizeof w.frame);
   dequantize4(rec, w, cv, b.values[i]);
+}
+
+// A quaternion track's three curves (from `curve`) into lanes i .. i + 2, or only its
+// component `only` (< 3) into lane i: one search of the shared mask gives every curve's window
+// (their key frames are the same); their Bases, then their Values, follow one another.
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void gather_track(const BlockView& v, uint32_t track, uint32_t curve, Batch& b,
+                                                uint32_t i, uint32_t only = kTrackCurves) noexcept {
+  const uint8_t* rec = v.payload + v.offsets[track];
+  uint64_t mask;
+  std::memcpy(&mask, rec, 8);
+  const uint32_t kw = rec[kTrackRecordBitsAt / 8 - 1];
+  Window w;
+  const uint32_t count = window_frames<kPopcnt>(rec, mask, kTrackRecordBitsAt / 8, kw, v.upto, w.frame);
+  const uint64_t values = popcount64<kPopcnt>(mask) + kContextKeys;  // per curve
+  uint64_t base_at = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw;
+  uint64_t at = base_at;
+  for (uint32_t k = 0; k < kTrackCurves; ++k) at += v.curves[curve + k].base_bits;
+  for (uint32_t k = 0; k < kTrackCurves; ++k) {
+    const Curve& cv = v.curves[curve + k];
+    const uint32_t vw = rec[8 + k];
+    if (only == kTrackCurves || only == k) {
+      const uint32_t lane = only == kTrackCurves ? i + k : i;
+      w.base = read_bits(rec, base_at, cv.base_bits);
+      w.value_bits = vw;
+      w.at = at + uint64_t(count) * vw;
+      std::memcpy(b.frames[lane], w.frame, sizeof w.frame);
+      dequantize4(rec, w, cv, b.values[lane]);
+    }
+    base_at += cv.base_bits;
+    at += values * vw;
+  }
+}
+
+// Block curve `curve`, whichever track holds it (a lookup: for the paths that list channels).
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void gather_curve(const Image& img, const BlockView& v, uint32_t curve, Batch& b,
+                                                uint32_t i) noexcept {
+  if (img.track_first.empty()) return gather<kPopcnt>(v, curve, curve, b, i);
+  const Image::TrackOf t = img.track_of(curve);
+  if (t.curves == 1) return gather<kPopcnt>(v, t.track, curve, b, i);
+  gather_track<kPopcnt>(v, t.track, curve - t.component, b, i, t.component);
+}
+
+// The curves of block track t: kTrackCurves or 1.
+inline uint32_t track_width(const Image& img, uint32_t t) noexcept {
+  if (img.track_first.empty()) return 1;
+  const uint32_t next = t + 1 < img.block_tracks ? img.track_first[t + 1] : img.block_curves;
+  return next - img.track_first[t];
 }
 
 // A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
@@ -245,18 +296,19 @@ Facts batch_facts(const Batch& b) {
   return {b.s, b.first_frame, b.last_frame, b.first_value, b.last_value, b.linear};
 }
 
-// The two passes over chunks of `count` lanes at position f: fill(b, at, view, base, m)
-// gathers lanes [base, base + m) into b, facts(b, base) says where their per-curve facts are,
-// emit(res, base, m) writes the results.
-template <bool kWide, class Fill, class FactsOf, class Emit>
-[[gnu::always_inline]] inline void run_chunks(const Image& img, float f, uint32_t count, Fill fill, FactsOf facts,
-                                              Emit emit) noexcept {
+// The two passes over chunks of `count` lanes at position f: size(base, count) says how many
+// lanes the chunk from `base` takes (at most kChunk), fill(b, at, view, base, m) gathers lanes
+// [base, base + m) into b, facts(b, base) says where their per-curve facts are, emit(res, base,
+// m) writes the results.
+template <bool kWide, class Size, class Fill, class FactsOf, class Emit>
+[[gnu::always_inline]] inline void run_chunks(const Image& img, float f, uint32_t count, Size size, Fill fill,
+                                              FactsOf facts, Emit emit) noexcept {
   Batch b;
   alignas(16) float res[kChunk];
   const Position at = position(img, f);
   const BlockView view = block_view(img, at);
-  for (uint32_t base = 0; base < count; base += kChunk) {
-    const uint32_t m = std::min(kChunk, count - base);
+  for (uint32_t base = 0, m = 0; base < count; base += m) {
+    m = size(base, count);
     fill(b, at, view, base, m);
     const uint32_t lanes = (m + 3) & ~3u;
     for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
@@ -278,7 +330,7 @@ template <bool kPopcnt, bool kWide>
         continue;
       }
       if (curve < img.block_curves)
-        gather<kPopcnt>(view, curve, b, i);
+        gather_curve<kPopcnt>(img, view, curve, b, i);
       else
         gather_list(img, curve, at, b, i);
       copy_facts(img, curve, b, i);
@@ -288,7 +340,8 @@ template <bool kPopcnt, bool kWide>
   auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
     std::memcpy(out + base, res, m * sizeof(float));
   };
-  run_chunks<kWide>(img, f, count, fill, facts, emit);
+  auto size = [](uint32_t base, uint32_t n) KEYANIM_INLINE { return std::min(kChunk, n - base); };
+  run_chunks<kWide>(img, f, count, size, fill, facts, emit);
 }
 
 // A record's largest size in bytes (spec 9.3: 10 bytes, four contexts of up to 31 bits, a base
@@ -306,18 +359,20 @@ constexpr uint64_t kRecordBytesBound = 512;
 // runs of each, cold_local median, keyanim / ACL): CMU 2.48 and 2.74 -> 1.83 and 1.87, Bandai
 // 3.47 and 3.33 -> 1.89 and 2.57; a warm local pose costs about 3% more instructions.
 [[gnu::always_inline]] inline void prefetch_pose(const Image& img, const BlockView& view, uint32_t block) noexcept {
-  // The fixed channels and the per-curve arrays are one range of the image (spec 9.2's order).
+  // The fixed channels, the per-curve arrays and the quaternion nodes' and tracks' arrays are
+  // one range of the image (spec 9.2's order; an empty array lies where it would start).
   using L = ImageLayout;
-  static_assert(L::curves == L::fixed_channels + 1 && L::curve_channel == L::curves + 7,
-                "fixed_channels, curves, curve_s .. curve_linear, curve_channel are consecutive");
+  static_assert(L::curves == L::fixed_channels + 1 && L::curve_channel == L::curves + 7 &&
+                    L::track_first == L::curve_channel + 4,
+                "fixed_channels, curves, curve_s .. curve_linear, curve_channel, quat_node .. track_first are consecutive");
   const auto* from = reinterpret_cast<const uint8_t*>(img.fixed_channels.data());
-  const auto* to = reinterpret_cast<const uint8_t*>(img.curve_channel.data() + img.curve_channel.size());
+  const auto* to = reinterpret_cast<const uint8_t*>(img.track_first.data() + img.track_first.size());
   prefetch_bytes(from, size_t(to - from));
   if (!img.fixed_channels.empty()) prefetch_array(img.fixed_value.data(), img.fixed_value.size());  // by channel
-  if (img.block_curves == 0) return;
-  prefetch_array(view.offsets, img.block_curves);
+  if (img.block_tracks == 0) return;
+  prefetch_array(view.offsets, img.block_tracks);
   const uint64_t first = view.offsets[0];
-  const uint64_t last = block + 1 < img.block_count ? view.offsets[img.block_curves] : img.payload.size();
+  const uint64_t last = block + 1 < img.block_count ? view.offsets[img.block_tracks] : img.payload.size();
   if (first < last) prefetch_array(view.payload + first, std::min(last - first, img.block_curves * kRecordBytesBound));
 }
 
@@ -330,10 +385,29 @@ template <bool kPopcnt, bool kWide>
     prefetch_pose(img, block_view(img, at), at.block);
   }
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
+  // Chunks end between tracks: a quaternion track's curves are gathered together.
+  uint32_t track = 0;
+  auto size = [&](uint32_t base, uint32_t count) KEYANIM_INLINE {
+    uint32_t m = 0;
+    for (uint32_t t = track; base + m < img.block_curves; ++t) {
+      const uint32_t w = track_width(img, t);
+      if (m + w > kChunk) return m;
+      m += w;
+    }
+    return std::min(kChunk, count - base);
+  };
   auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
-    const uint32_t blocked = base < img.block_curves ? std::min(m, img.block_curves - base) : 0;
-    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(view, base + i, b, i);
-    for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, at, b, i);
+    uint32_t i = 0;
+    for (; i < m && base + i < img.block_curves; ++track) {
+      if (track_width(img, track) == 1) {
+        gather<kPopcnt>(view, track, base + i, b, i);
+        ++i;
+      } else {
+        gather_track<kPopcnt>(view, track, base + i, b, i);
+        i += kTrackCurves;
+      }
+    }
+    for (; i < m; ++i) gather_list(img, base + i, at, b, i);
   };
   auto facts = [&](const Batch&, uint32_t base) KEYANIM_INLINE {
     return Facts{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
@@ -343,7 +417,7 @@ template <bool kPopcnt, bool kWide>
     const uint32_t* channel = img.curve_channel.data() + base;
     for (uint32_t i = 0; i < m; ++i) out[channel[i]] = res[i];
   };
-  run_chunks<kWide>(img, f, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
+  run_chunks<kWide>(img, f, static_cast<uint32_t>(img.curves.size()), size, fill, facts, emit);
 }
 
 // One copy per CPU level (internal/cpu.h); popcnt from the popcnt level on, 8 lanes at v3.
@@ -409,28 +483,28 @@ void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexce
   }
   s.list = nullptr;
   const Position at = position(img, f);
-  const uint8_t* rec = img.record(at.block, curve);
+  CurveFields fl;
+  const uint8_t* rec = curve_record(img, at.block, curve, fl);
+  const uint64_t upto = frames_upto(at.t);
   Window w;
-  read_window<false>(rec, cv.base_bits, frames_upto(at.t), w);
+  const uint32_t below = window_frames<false>(rec, fl.mask, fl.context_at, fl.context_bits, upto, w.frame);
+  w.base = read_bits(rec, fl.base_at, cv.base_bits);
+  w.value_bits = fl.value_bits;
+  w.at = fl.values_at + uint64_t(below) * fl.value_bits;
   float v[4];
   dequantize4(rec, w, cv, v);
   const int32_t start = static_cast<int32_t>(at.block << kBlockShift);
   for (int i = 0; i < 4; ++i) s.k[i] = w.frame[i] + start, s.v[i] = v[i];
   // Where key j+3 is: the block keys after key j+2, or the context keys after the block.
-  uint64_t mask;
-  std::memcpy(&mask, rec, 8);
-  const uint32_t kw = rec[9];
   int32_t c[4];
-  read_context(rec, kw, c);
+  read_context(rec, fl.context_at, fl.context_bits, c);
   s.after[0] = c[2] + start, s.after[1] = c[3] + start;
-  const uint64_t upto = frames_upto(at.t);
-  const uint64_t above = mask & ~upto;
+  const uint64_t above = fl.mask & ~upto;
   const uint64_t above_rest = above & (above - 1);
   s.rest = above_rest & (above_rest - 1);
   s.after_used = above_rest ? 0 : above ? 1 : 2;
-  const uint32_t below = popcount64<false>(mask & upto);
   s.value_bits = w.value_bits;
-  s.next_at = kRecordBitsAt + 4 * uint64_t(kw) + cv.base_bits + uint64_t(below + 4) * w.value_bits;
+  s.next_at = fl.values_at + uint64_t(below + 4) * w.value_bits;
   s.low = cv.q_base + static_cast<int64_t>(w.base);
   s.block = static_cast<int32_t>(at.block);
   s.rec = rec;

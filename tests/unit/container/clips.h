@@ -314,6 +314,42 @@ inline EncodedClip random_clip(uint64_t seed, uint32_t frames, uint32_t joints) 
   return c;
 }
 
+// A pseudo-random clip whose joints' rotations are stored as quaternions (version 5): every
+// joint's x, y, z share key frames (dense, sparse enough to be list curves, or one key), with
+// values within a quarter turn of the reference, which differs from joint to joint; the root
+// keeps Euler channels when `euler_root`, and its positions are values.
+inline EncodedClip random_quat_clip(uint64_t seed, uint32_t frames, uint32_t joints, bool euler_root = false) {
+  EncodedClip c = random_clip(seed, frames, joints);
+  uint64_t s = seed * 7 + 1;
+  c.skeleton.assign_channel_columns();
+  for (uint32_t j = euler_root ? 1 : 0; j < joints; ++j) {
+    keyanim::QuatNode n;
+    n.node = j;
+    const double h[3] = {double(lcg(s) % 1000) / 1000.0 - 0.5, double(lcg(s) % 1000) / 1000.0 - 0.5,
+                         double(lcg(s) % 1000) / 1000.0 - 0.5};
+    const double norm = std::sqrt(1.0 + h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    n.reference[0] = float(h[0] / norm), n.reference[1] = float(h[1] / norm), n.reference[2] = float(h[2] / norm);
+    n.reference[3] = float(1.0 / norm);
+    c.quat_nodes.push_back(n);
+    const uint32_t first = c.skeleton.joints[j].first_channel + (j == 0 ? 3 : 0);
+    const uint32_t density = j % 4 == 0 ? 1 : j % 4 == 1 ? 3 : j % 4 == 2 ? 200 : 100000;
+    const double step = 1.0 / double(1u << (12 + lcg(s) % 6));
+    std::vector<uint32_t> keys;
+    for (uint32_t f = 0; f < frames; ++f)
+      if (f == 0 || lcg(s) % density == 0) keys.push_back(f);
+    const Interpolation interp = lcg(s) % 4 == 0 ? kLin : kCard;
+    const float tension = float(int(lcg(s) % 11) - 5) / 10.0f;
+    for (uint32_t k = 0; k < 3; ++k) {
+      EncodedChannel& e = c.channels[first + k];
+      e.interp = interp, e.tension = tension, e.step = step * (k + 1), e.frames = keys;
+      e.q.clear();
+      for (size_t i = 0; i < keys.size(); ++i)  // |x|, |y|, |z| below 0.38: w above 0.5
+        e.q.push_back(std::llround((double(lcg(s) % 20001) / 10000.0 - 1.0) * 0.38 / e.step));
+    }
+  }
+  return c;
+}
+
 inline std::vector<uint8_t> read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -351,25 +387,30 @@ inline void check_same_clip(const Clip& a, const Clip& b) {
   }
 }
 
-// Samples every quarter frame (and outside the clip) of both clips, bit-exactly, and checks
-// each against eval_channel on the clip's own arrays.
+// Samples every quarter frame (and outside the clip) of both clips, bit-exactly (stored values,
+// and the channels' values: for quaternion nodes their Euler angles), and checks each stored
+// value against eval_channel on the clip's own keys.
 inline void check_same_samples(const Clip& a, const Clip& b) {
   const uint32_t n = a.channel_count();
-  std::vector<float> sa(n), sb(n);
+  std::vector<float> sa(n), sb(n), ea(n), eb(n);
   keyanim::Cursor cursor;
   REQUIRE(cursor.prepare(b) == Status::ok);
   const auto keys = keyanim::test::all_channel_keys(a);
-  uint64_t mismatches = 0, eval_mismatches = 0;
+  uint64_t mismatches = 0, eval_mismatches = 0, angle_mismatches = 0;
   const double end = double(a.frame_count()) + 1.0;
   for (double x = -2.0; x <= end; x += 0.25) {
-    REQUIRE(a.sample(x, sa) == Status::ok);
-    REQUIRE(b.sample(x, sb, &cursor) == Status::ok);
+    REQUIRE(a.sample_stored(x, sa) == Status::ok);
+    REQUIRE(b.sample_stored(x, sb, &cursor) == Status::ok);
+    REQUIRE(a.sample(x, ea) == Status::ok);
+    REQUIRE(b.sample(x, eb) == Status::ok);
     for (uint32_t c = 0; c < n; ++c) {
       if (!same_bits(sa[c], sb[c])) ++mismatches;
+      if (!same_bits(ea[c], eb[c])) ++angle_mismatches;
       if (!same_bits(sa[c], keyanim::test::reference_value(a, keys[c], float(x)))) ++eval_mismatches;
     }
   }
   CHECK(mismatches == 0);
+  CHECK(angle_mismatches == 0);
   CHECK(eval_mismatches == 0);
 }
 

@@ -23,7 +23,10 @@ struct ResampleOptions {
 //   inbetweens N:  first + i / (N + 1)                 ((last - first) (N + 1) + 1 frames)
 //   fps:           as RateMap below
 // Values are the clip's float samples as doubles; frame_time becomes frame_time / (N + 1) or
-// 1 / fps. A clip without frames decodes to no frames.
+// 1 / fps. A quaternion node's rotation channels (version 5) are its Euler angles computed in
+// binary64 from its stored values (spec Appendix B), each frame's the solution nearest the
+// frame decoded before it, so that a rebuilt BVH file's channels are continuous. A clip without
+// frames decodes to no frames.
 //
 // The rule for a rate. BVH files store Frame Time rounded (.0083333 for 1/120 s), so a rate
 // asked for is compared with the clip's own first: a rate within 0.01% (kRateSnap) of N times
@@ -63,7 +66,8 @@ class FrameDecoder {
   void start(const Clip& clip, const ResampleOptions& options);
   uint64_t frame_count() const noexcept { return count_; }
   double frame_time() const noexcept { return frame_time_; }
-  // Output frame i < frame_count(): clip.channel_count() values. Fastest in increasing i.
+  // Output frame i < frame_count(): clip.channel_count() values. Fastest in increasing i (and a
+  // quaternion node's angles are continuous from call to call).
   void frame(uint64_t i, std::span<double> row);
 
  private:
@@ -74,6 +78,16 @@ class FrameDecoder {
   double frame_time_ = 0.0;
   RateMap rate_;  // with fps
   std::vector<float> pose_;
+  // Per quaternion node: where its channels are, their axes, and the angles last decoded.
+  struct QuatAngles {
+    QuatNode node;
+    uint32_t column = 0;
+    uint8_t axes[3] = {};
+    double previous[3] = {};
+    bool have_previous = false;
+  };
+  std::vector<QuatAngles> quats_;
+  void quat_angles(QuatAngles& q, std::span<double> row);
   Cursor cursor_;
 };
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "keyanim/cardinal.h"
+#include "keyanim/rotation.h"
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/metrics.h"
 #include "keyanim/offline/motion.h"
@@ -72,6 +73,11 @@ struct EncodedClip {
   double frame_time = 0.0;
   TangentRule tangent_rule = TangentRule::step_adjusted;
   std::vector<EncodedChannel> channels;
+  // Nodes whose rotation is stored as quaternion curves (spec section 4.7), in increasing node
+  // order: each one's rotation channels c, c + 1, c + 2 (quaternion_capable) hold x, y, z of its
+  // rotation relative to the node's reference, with the same interpolation, tension and key
+  // frames (steps may differ). Empty: every rotation is its Euler channels (a 3.0 file).
+  std::vector<QuatNode> quat_nodes;
   std::string notes;  // informative key=value lines (settings, achieved error)
 };
 

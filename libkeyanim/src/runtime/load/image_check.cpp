@@ -11,6 +11,7 @@
 #include "internal/format.h"
 #include "keyanim/cardinal.h"
 #include "runtime/image.h"
+#include "keyanim/version.h"
 #include "runtime/load/loader.h"
 
 namespace keyanim::internal {
@@ -36,22 +37,29 @@ bool same_bits(float a, float b) noexcept { return float_bits(a) == float_bits(b
 const char* const kArrayNames[L::kArrays] = {
     "Interpolation", "Tension", "Key_Count", "Curve_Of", "Fixed_Value", "Fixed_Frame", "Fixed_Channels",
     "Curves", "Curve_S", "First_Frame", "Last_Frame", "First_Value", "Last_Value", "Curve_Linear",
-    "Curve_Channel", "Lists", "List_Frames", "List_Values", "List_Q", "Record_Offset", "Payload"};
+    "Curve_Channel", "Quat_Node", "Quat_Column", "Quat_Reference", "Track_First", "Lists", "List_Frames",
+    "List_Values", "List_Q", "Record_Offset", "Payload"};
 
 }  // namespace
 
-// The checks, in section 9.2's order. `where(a, i)` names entry i of array a.
-Status Loader::check_image(const Content& c, const ClipSource& parts) {
+// The checks, in section 9.2's order. `where(a, i)` names entry i of array a. `skeleton`: SKEL's
+// (parsed, or a cached rig's), which the quaternion nodes are checked against.
+Status Loader::check_image(const Content& c, const ClipSource& parts, const Skeleton& skeleton) {
   const uint64_t frames = parts.frame_count, channels = channel_count_;
   if (c.size < kImageHeaderBytes) return fail_in(Status::corrupt, c, 0, "IMAG is shorter than its 32-byte header");
   uint32_t h[8];
   std::memcpy(h, c.data, sizeof h);
   if (h[0] != kBlockShift) return fail_in(Status::corrupt, c, 0, "Block_Shift must be 6, not " + std::to_string(h[0]));
-  if (h[6] != 0 || h[7] != 0) return fail_in(Status::reserved_bits_set, c, 24, "Image_Reserved is not 0");
-  const ImageCounts n{channels, h[1], h[2], h[3], h[4], h[5]};
+  if (major_ < kQuatFormatVersionMajor && (h[6] != 0 || h[7] != 0))
+    return fail_in(Status::reserved_bits_set, c, 24, "Image_Reserved is not 0");
+  const ImageCounts n = image_counts({c.data, c.size}, static_cast<uint32_t>(channels));
   if (n.curves > channels)
     return fail_in(Status::corrupt, c, 4, "Curve_Count " + std::to_string(n.curves) + " is above Channel_Count");
   if (n.block_curves > n.curves) return fail_in(Status::corrupt, c, 8, "Block_Curve_Count is above Curve_Count");
+  if (n.quat_nodes > skeleton.joints.size())
+    return fail_in(Status::corrupt, c, 24, "Quat_Count " + std::to_string(n.quat_nodes) + " is above Node_Count");
+  if (n.block_tracks > n.block_curves || (n.quat_nodes == 0 && major_ >= kQuatFormatVersionMajor && h[7] != n.block_curves))
+    return fail_in(Status::corrupt, c, 28, "Block_Track_Count must be the block tracks' count (Block_Curve_Count without quaternion nodes)");
   const uint64_t blocks_of_clip = (frames + kBlockFrames - 1) / kBlockFrames;
   if (n.blocks != (n.curves > 0 ? blocks_of_clip : 0))
     return fail_in(Status::corrupt, c, 12, "Block_Count must be " + std::to_string(n.curves > 0 ? blocks_of_clip : 0));
@@ -98,7 +106,57 @@ Status Loader::check_image(const Content& c, const ClipSource& parts) {
   if (fixed != channels - n.curves)
     return fail_in(Status::corrupt, c, lay.at[L::fixed_channels], "Fixed_Channels must list the channels of fewer than 2 keys");
   if (Status s = check_image_curves(c, lay, n, parts); s != Status::ok) return s;
-  return check_image_records(c, lay, n, parts);
+  std::vector<uint32_t> tracks;  // each block track's first curve
+  if (Status s = check_image_quats(c, lay, n, skeleton, tracks); s != Status::ok) return s;
+  return check_image_records(c, lay, n, parts, tracks);
+}
+
+// Version 5: the quaternion nodes (section 4.7's rules on the skeleton and the channels) and
+// the block tracks they make, into `tracks` (each one's first curve).
+Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const Skeleton& skeleton,
+                                 std::vector<uint32_t>& tracks) {
+  std::vector<QuatNode> nodes(n.quat_nodes);
+  const uint64_t lanes = L::lanes(n.quat_nodes);
+  for (uint64_t i = 0; i < lanes; ++i) {
+    float ref[4];
+    for (uint64_t k = 0; k < 4; ++k) ref[k] = at_index<float>(c, lay, L::quat_reference, k * lanes + i);
+    const uint64_t ref_at = lay.at[L::quat_reference] + 4 * i;
+    if (i >= n.quat_nodes) {
+      if (float_bits(ref[0]) != 0 || float_bits(ref[1]) != 0 || float_bits(ref[2]) != 0 || ref[3] != 1.0f)
+        return fail_in(Status::corrupt, c, ref_at, "quaternion lane " + std::to_string(i) + " is padding, and must be (0, 0, 0, 1)");
+      continue;
+    }
+    const uint32_t node = at_index<uint32_t>(c, lay, L::quat_node, i);
+    const uint64_t node_at = lay.at[L::quat_node] + 4 * i;
+    if (node >= skeleton.joints.size() || (i > 0 && node <= nodes[i - 1].node) || !quaternion_capable(skeleton.joints[node]))
+      return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "] must be a node with three consecutive rotation channels about three axes, in increasing order");
+    if (at_index<uint32_t>(c, lay, L::quat_column, i) != quat_column(skeleton, node))
+      return fail_in(Status::corrupt, c, lay.at[L::quat_column] + 4 * i, "Quat_Column[" + std::to_string(i) + "] is not its node's first rotation channel");
+    nodes[i].node = node;
+    std::memcpy(nodes[i].reference, ref, sizeof ref);
+    if (!valid_reference(nodes[i].reference))
+      return fail_in(Status::corrupt, c, ref_at, "Quat_Reference " + std::to_string(i) + " is not a unit quaternion in binary32");
+  }
+  const std::vector<Stored> kinds = stored_kinds(skeleton, nodes);
+  for (uint64_t ch = 0; ch < n.channels; ++ch) {
+    if (kinds[ch] != Stored::quat_y && kinds[ch] != Stored::quat_z) continue;
+    const uint64_t x = ch - (kinds[ch] == Stored::quat_y ? 1 : 2);
+    if (c.data[lay.at[L::interpolation] + ch] != c.data[lay.at[L::interpolation] + x] ||
+        at_index<uint32_t>(c, lay, L::tension, ch) != at_index<uint32_t>(c, lay, L::tension, x) ||
+        at_index<uint32_t>(c, lay, L::key_count, ch) != at_index<uint32_t>(c, lay, L::key_count, x))
+      return fail_in(Status::corrupt, c, lay.at[L::key_count] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
+  }
+  for (uint32_t i = 0; i < n.block_curves;) {
+    tracks.push_back(i);
+    i += kinds[at_index<uint32_t>(c, lay, L::curve_channel, i)] == Stored::quat_x ? kTrackCurves : 1;
+  }
+  if (tracks.size() != n.block_tracks)
+    return fail_in(Status::corrupt, c, 28, "Block_Track_Count must be " + std::to_string(tracks.size()) + ", the block tracks' count");
+  if (n.quat_nodes > 0)
+    for (uint64_t t = 0; t < tracks.size(); ++t)
+      if (at_index<uint32_t>(c, lay, L::track_first, t) != tracks[t])
+        return fail_in(Status::corrupt, c, lay.at[L::track_first] + 4 * t, "Track_First[" + std::to_string(t) + "] must be " + std::to_string(tracks[t]));
+  return Status::ok;
 }
 
 // Curve facts, padding lanes and lists.
@@ -170,54 +228,62 @@ Status Loader::check_image_curves(const Content& c, const ImageLayout& lay, cons
   return Status::ok;
 }
 
-// Records, block after block (Record_Offset's order): offsets, sizes, widths, zero bits, masks,
-// window order; per curve the popcounts and the first and last key.
+// Records, block after block (Record_Offset's order), track after track: offsets, sizes, widths,
+// zero bits, masks, window order; per curve the popcounts and the first and last key.
 Status Loader::check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n,
-                                   const ClipSource& parts) {
-  const uint64_t frames = parts.frame_count, nb = n.block_curves;
+                                   const ClipSource& parts, const std::vector<uint32_t>& tracks) {
+  const uint64_t frames = parts.frame_count, nb = n.block_curves, nt = tracks.size();
   const uint8_t* payload = c.data + lay.at[L::payload];
   const uint64_t payload_at = lay.at[L::payload];
   std::vector<uint32_t> seen(nb, 0);        // keys so far
   std::vector<int64_t> last_key(nb, -1);    // the last key's frame so far
   uint64_t running = 0;
+  auto curve_at = [&](uint64_t i) { return lay.at[L::curves] + uint64_t(kCurveBytes) * i; };
   for (uint64_t b = 0; b < n.blocks; ++b) {
     const int64_t start = int64_t(b) << kBlockShift;
     const uint64_t beyond = frames - uint64_t(start) >= kBlockFrames ? 0 : ~uint64_t(0) << (frames - uint64_t(start));
-    for (uint64_t i = 0; i < nb; ++i) {
-      const uint64_t r = b * nb + i;
+    for (uint64_t t = 0; t < nt; ++t) {
+      const uint64_t r = b * nt + t;
+      const uint32_t i0 = tracks[t], curves = uint32_t((t + 1 < nt ? tracks[t + 1] : nb) - i0);
+      const std::string record = "record " + std::to_string(r);
       const uint64_t off_at = lay.at[L::record_offset] + 4 * r;
       if (at_index<uint32_t>(c, lay, L::record_offset, r) != running)
         return fail_in(Status::corrupt, c, off_at, "Record_Offset[" + std::to_string(r) + "] must be " + std::to_string(running) + ", where the previous record ends");
-      if (n.payload - running < 10) return fail_in(Status::corrupt, c, off_at, "record " + std::to_string(r) + " starts past the payload's end");
+      const uint32_t header = (curves == 1 ? kRecordBitsAt : kTrackRecordBitsAt) / 8;
+      if (n.payload - running < header) return fail_in(Status::corrupt, c, off_at, record + " starts past the payload's end");
       const uint8_t* rec = payload + running;
       uint64_t mask;
       std::memcpy(&mask, rec, 8);
-      const uint32_t vw = rec[8], kw = rec[9];
-      if (vw > kMaxValueBits)
-        return fail_in(Status::corrupt, c, payload_at + running + 8, "record " + std::to_string(r) + ": Value_Bits above 55");
+      const uint32_t kw = rec[header - 1];
+      for (uint32_t k = 0; k < curves; ++k)
+        if (rec[8 + k] > kMaxValueBits)
+          return fail_in(Status::corrupt, c, payload_at + running + 8 + k, record + ": Value_Bits above 55");
       if (kw > kMaxContextBits)
-        return fail_in(Status::corrupt, c, payload_at + running + 9, "record " + std::to_string(r) + ": Context_Bits above 31");
-      if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, "record " + std::to_string(r) + ": a key at or after Frame_Count");
-      const uint32_t wc = load_le<uint32_t>(c.data + lay.at[L::curves] + uint64_t(kCurveBytes) * i + 16);
-      const uint32_t m = static_cast<uint32_t>(__builtin_popcountll(mask));
-      const uint64_t bits = kRecordBitsAt + uint64_t(kContextKeys) * kw + wc + uint64_t(m + kContextKeys) * vw;
+        return fail_in(Status::corrupt, c, payload_at + running + header - 1, record + ": Context_Bits above 31");
+      if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, record + ": a key at or after Frame_Count");
+      uint32_t base_bits[kTrackCurves];
+      for (uint32_t k = 0; k < curves; ++k) base_bits[k] = load_le<uint32_t>(c.data + curve_at(i0 + k) + 16);
+      const uint64_t bits = curve_fields(rec, 0, curves, base_bits).end;  // the widths read are within the payload
       const uint64_t size = (bits + 7) / 8;
-      if (size > n.payload - running) return fail_in(Status::corrupt, c, payload_at + running, "record " + std::to_string(r) + " runs past the payload's end");
+      if (size > n.payload - running) return fail_in(Status::corrupt, c, payload_at + running, record + " runs past the payload's end");
       if ((bits & 7) != 0 && (rec[size - 1] >> (bits & 7)) != 0)
-        return fail_in(Status::corrupt, c, payload_at + running + size - 1, "record " + std::to_string(r) + ": the bits after its last field are not zero");
+        return fail_in(Status::corrupt, c, payload_at + running + size - 1, record + ": the bits after its last field are not zero");
+      const uint32_t m = static_cast<uint32_t>(__builtin_popcountll(mask));
       int32_t e[4];
-      read_context(rec, kw, e);  // relative to the block's start; e[2], e[3] already + 64
+      read_context(rec, header, kw, e);  // relative to the block's start; e[2], e[3] already + 64
       // The window's frames increase: two before the block's keys, its keys, two after them
       // (virtual keys beyond the curve's ends may lie inside the block).
       const int32_t lo = m > 0 ? low_bit(mask) : e[2], hi = m > 0 ? top_bit(mask) : e[1];
       if (!(e[0] < e[1] && e[1] < lo && hi < e[2] && e[2] < e[3]))
-        return fail_in(Status::corrupt, c, payload_at + running + 10,
-                       "record " + std::to_string(r) + ": its context frames are not two before and two after the block's keys, increasing");
-      const int64_t base = static_cast<int64_t>(read_bits(rec, kRecordBitsAt + uint64_t(kContextKeys) * kw, wc));
-      const int64_t q_base = load_le<int64_t>(c.data + lay.at[L::curves] + uint64_t(kCurveBytes) * i);
-      if (q_base + base > kMaxAbsQ)
-        return fail_in(Status::corrupt, c, payload_at + running + 10, "record " + std::to_string(r) + ": Q_Base + Base is above 2^53");
-      if (m > 0) {
+        return fail_in(Status::corrupt, c, payload_at + running + header,
+                       record + ": its context frames are not two before and two after the block's keys, increasing");
+      for (uint32_t k = 0; k < curves; ++k) {
+        const uint64_t i = i0 + k;
+        const CurveFields f = curve_fields(rec, k, curves, base_bits);
+        const int64_t base = static_cast<int64_t>(read_bits(rec, f.base_at, base_bits[k]));
+        if (load_le<int64_t>(c.data + curve_at(i)) + base > kMaxAbsQ)
+          return fail_in(Status::corrupt, c, payload_at + running + header, record + ": Q_Base + Base is above 2^53");
+        if (m == 0) continue;
         const float f0 = at_index<float>(c, lay, L::first_frame, i);
         if (seen[i] == 0 && f0 != float(start + low_bit(mask)))
           return fail_in(Status::corrupt, c, lay.at[L::first_frame] + 4 * i, "curve " + std::to_string(i) + ": First_Frame is not its first key");
@@ -235,7 +301,7 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
     if (at_index<float>(c, lay, L::last_frame, i) != float(last_key[i]))
       return fail_in(Status::corrupt, c, lay.at[L::last_frame] + 4 * i, "curve " + std::to_string(i) + ": Last_Frame is not its last key");
   }
-  const uint64_t records = n.blocks * nb;
+  const uint64_t records = n.blocks * nt;
   for (uint64_t r = records; r < records + kImageTailEntries; ++r)
     if (at_index<uint32_t>(c, lay, L::record_offset, r) != 0)
       return fail_in(Status::corrupt, c, lay.at[L::record_offset] + 4 * r, "Record_Offset's 8 extra entries must be 0");

@@ -36,9 +36,10 @@ Status Loader::run(ClipSource& parts) {
       if ((s = get_content(e, "NOTE", c)) != Status::ok) return s;
       parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);
     } else {
-      for (int k = 0; k < 5; ++k) {
+      for (int k = 0; k < 6; ++k) {
         if (critical_index_[k] != static_cast<int>(i)) continue;
         switch (k) {
+          case internal::kQuatSlot: s = get_content(e, "QUAT", c, k, &parts); if (s == Status::ok) s = parse_quat(c, parts); break;
           case 0:
             s = get_content(e, "CLIP", c, 0, &parts);
             if (s == Status::ok) s = parse_clip(c, parts);
@@ -60,19 +61,20 @@ Status Loader::run(ClipSource& parts) {
   return Status::ok;
 }
 
-// CLIP, IMAG, SKEL (entries 0, 1 and a later one, uncompressed), and NOTE.
+// CLIP, IMAG, SKEL (entries 0, 1 and a later one, uncompressed), and NOTE. SKEL is read before
+// IMAG is checked: IMAG's quaternion nodes are checked against it (version 5).
 Status Loader::run_runtime(ClipSource& parts) {
   Content c;
   Status s = get_content(table_[0], "CLIP", c);
   if (s == Status::ok) s = parse_clip(c, parts);
-  if (s == Status::ok) s = get_content(table_[1], "IMAG", imag_);
-  if (s == Status::ok) s = check_image(imag_, parts);
   if (s == Status::ok) s = get_skel(critical_index_[2], skel_);
   if (s == Status::ok && rigs_ != nullptr) rig_ = RigCacheAccess::find_skel(*rigs_, skel());
   // Equal SKEL bytes were parsed and checked once; CLIP's counts must still agree with them.
   if (rig_ != nullptr && (rig_->skeleton.joints.size() != node_count_ || rig_->skeleton.channel_count() != channel_count_))
     rig_ = nullptr;
   if (s == Status::ok && rig_ == nullptr) s = parse_skel(skel_, parts);
+  if (s == Status::ok) s = get_content(table_[1], "IMAG", imag_);
+  if (s == Status::ok) s = check_image(imag_, parts, rig_ != nullptr ? rig_->skeleton : parts.skeleton);
   if (s == Status::ok && note_index_ >= 0) {
     s = get_content(table_[static_cast<size_t>(note_index_)], "NOTE", c);
     if (s == Status::ok) parts.notes.assign(reinterpret_cast<const char*>(c.data), c.size);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "internal/clip_source.h"
+#include "internal/quat_layout.h"
 #include "internal/value_coding.h"
 #include "keyanim/clip.h"
 #include "runtime/image_layout.h"
@@ -116,14 +117,18 @@ class Loader {
   uint64_t kval_fixed_bytes(const ClipSource& parts) const noexcept;
   Status parse_clip(const Content& c, ClipSource& parts);
   Status parse_skel(const Content& c, ClipSource& parts);
+  Status parse_quat(const Content& c, ClipSource& parts);  // 5.x
   Status parse_chan(const Content& c, ClipSource& parts);
   Status parse_ktim(const Content& c, ClipSource& parts);
   Status parse_kval(const Content& c, ClipSource& parts);        // 1.x and 2.x: varint planes
   Status parse_kval_fixed(const Content& c, ClipSource& parts);  // 3.x: fixed-width byte planes
   // IMAG (image_check.cpp): the header, the channels, then the curves and lists, then the records.
-  Status check_image(const Content& c, const ClipSource& parts);
+  Status check_image(const Content& c, const ClipSource& parts, const Skeleton& skeleton);
   Status check_image_curves(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
-  Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
+  Status check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const Skeleton& skeleton,
+                           std::vector<uint32_t>& tracks);
+  Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts,
+                             const std::vector<uint32_t>& tracks);
   Status run_runtime(ClipSource& parts);  // run() for the runtime profile
   // A member's skeleton as SKEL's content (MemberContext); else table entry `index`'s.
   Status get_skel(int index, Content& out);
@@ -147,7 +152,9 @@ class Loader {
   const MemberContext* member_ = nullptr;
   std::shared_ptr<const Rig> rig_;
   std::vector<TableEntry> table_;
-  int critical_index_[5] = {-1, -1, -1, -1, -1};  // table index of CLIP..KVAL (runtime: CLIP, IMAG, SKEL)
+  // Table index of CLIP, SKEL, CHAN, KTIM, KVAL, QUAT (kQuatSlot; 5.x archive); runtime: CLIP,
+  // IMAG, SKEL.
+  int critical_index_[6] = {-1, -1, -1, -1, -1, -1};
   int note_index_ = -1;
   std::unique_ptr<ZSTD_DCtx, DctxDeleter> dctx_;
   // Decompressed sections, alive until parsed. Not zero-filled: a small file declaring a large
@@ -161,6 +168,10 @@ class Loader {
   // From CHAN, needed by KVAL.
   std::vector<internal::ValueCoding> codings_;  // all delta in 1.x
   std::vector<uint8_t> residual_bytes_;         // 3.x
+  // From QUAT and CHAN (5.x): what each channel stores, and the key frames KTIM holds (a
+  // quaternion node's y and z share its x's).
+  std::vector<Stored> kinds_;
+  uint64_t time_count_ = 0;
 };
 
 }  // namespace keyanim::internal

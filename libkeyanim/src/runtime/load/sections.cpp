@@ -1,11 +1,14 @@
 // CLIP, SKEL, CHAN and KTIM: the clip's facts, the skeleton, the channel table and the key
 // frames, each checked against what came before it.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "internal/byte_reader.h"
 #include "internal/format.h"
 #include "internal/varint.h"
+#include "keyanim/version.h"
 #include "runtime/load/loader.h"
 
 namespace keyanim::internal {
@@ -42,16 +45,21 @@ Status Loader::parse_clip(const Content& c, ClipSource& parts) {
     return fail_in(Status::corrupt, c, 16, "Frame_Time must be finite, >= 0, and > 0 when Frame_Count > 1");
   if (key_count_ > limits_.max_keys)
     return fail_in(Status::limit_exceeded, c, 24, "Key_Count " + std::to_string(key_count_) + " exceeds the limit");
-  if (key_count_ > internal::kMaxKeysPerFileByte * uint64_t(bytes_.size()))
+  // A key takes a byte of KTIM at least (a third of one from 5.0, where a quaternion node's
+  // three curves share their key frames), and zstd makes at most kMaxZstdExpansion of each.
+  const uint64_t per_byte = major_ >= kQuatFormatVersionMajor ? internal::kMaxKeysPerFileByteV5 : internal::kMaxKeysPerFileByte;
+  if (key_count_ > per_byte * uint64_t(bytes_.size()))
     return fail_in(Status::corrupt, c, 24,
                    "Key_Count " + std::to_string(key_count_) + " is more than a file of " + std::to_string(bytes_.size()) +
-                       " bytes can hold (at most " + std::to_string(internal::kMaxKeysPerFileByte) +
-                       " keys a byte: a key takes a byte of KTIM at least, and zstd makes at most " +
-                       std::to_string(internal::kMaxZstdExpansion) + " bytes of each)");
+                       " bytes can hold (at most " + std::to_string(per_byte) + " keys a byte: a key takes " +
+                       (major_ >= kQuatFormatVersionMajor ? "a third of a byte" : "a byte") +
+                       " of KTIM at least, and zstd makes at most " + std::to_string(internal::kMaxZstdExpansion) +
+                       " bytes of each)");
   if (key_count_ > UINT32_MAX)
     return fail_in(Status::limit_exceeded, c, 24, "this decoder holds fewer than 2^32 keys");
   if (key_count_ > uint64_t(channel_count_) * frames)
     return fail_in(Status::corrupt, c, 24, "Key_Count exceeds Channel_Count x Frame_Count");
+  time_count_ = key_count_;  // until QUAT and CHAN say which curves share their key frames
   parts.frame_count = frames;
   parts.frame_time = frame_time;
   parts.rule = static_cast<TangentRule>(rule);
@@ -117,6 +125,28 @@ Status Loader::parse_skel(const Content& c, ClipSource& parts) {
   return Status::ok;
 }
 
+Status Loader::parse_quat(const Content& c, ClipSource& parts) {
+  uint32_t count = 0;
+  ByteReader r(c.data, c.size);
+  if (!r.read(count) || count > node_count_ || c.size != internal::kQuatHeaderBytes + uint64_t(count) * internal::kQuatEntryBytes)
+    return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 20 x Quat_Count bytes, Quat_Count at most Node_Count");
+  parts.quat_nodes.resize(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    QuatNode& n = parts.quat_nodes[i];
+    const size_t at = r.pos();
+    r.read(n.node);
+    for (float& x : n.reference) r.read(x);
+    const std::string entry = "QUAT entry " + std::to_string(i) + ": ";
+    if (n.node >= node_count_ || (i > 0 && n.node <= parts.quat_nodes[i - 1].node))
+      return fail_in(Status::corrupt, c, at, entry + "Node must be a node, in increasing order");
+    if (!quaternion_capable(parts.skeleton.joints[n.node]))
+      return fail_in(Status::corrupt, c, at, entry + "the node must have three consecutive rotation channels about three axes");
+    if (!internal::valid_reference(n.reference))
+      return fail_in(Status::corrupt, c, at + 4, entry + "Reference must be a unit quaternion in binary32");
+  }
+  return Status::ok;
+}
+
 Status Loader::parse_chan(const Content& c, ClipSource& parts) {
   const uint64_t channels = channel_count_;
   const size_t per_channel = major_ >= 3   ? internal::kChanBytesPerChannel
@@ -169,6 +199,17 @@ Status Loader::parse_chan(const Content& c, ClipSource& parts) {
   }
   if (key_sum != key_count_)
     return fail_in(Status::corrupt, c, 13 * channels, "the channels' Key_Count add up to less than CLIP's");
+  // A quaternion node's x, y and z: one interpolation, tension and key count (section 4.7).
+  kinds_ = internal::stored_kinds(parts.skeleton, parts.quat_nodes);
+  for (uint64_t i = 0; i < channels; ++i) {
+    if (kinds_[i] != internal::Stored::quat_y && kinds_[i] != internal::Stored::quat_z) continue;
+    const SourceChannel& x = parts.channels[i - (kinds_[i] == internal::Stored::quat_y ? 1 : 2)];
+    const SourceChannel& t = parts.channels[i];
+    if (t.interp != x.interp || std::memcmp(&t.tension, &x.tension, sizeof(float)) != 0 || t.key_count != x.key_count)
+      return fail_in(Status::corrupt, c, i, "channel " + std::to_string(i) +
+                                                ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
+    time_count_ -= t.key_count;
+  }
   return Status::ok;
 }
 
@@ -183,13 +224,18 @@ const char* varint_problem(internal::VarintError e) {
 }
 
 Status Loader::parse_ktim(const Content& c, ClipSource& parts) {
-  if (key_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KTIM is too short for Key_Count varints");
+  if (time_count_ > c.size) return fail_in(Status::corrupt, c, 0, "KTIM is too short for its key frames' varints");
   parts.frames.resize(static_cast<size_t>(key_count_));
   uint32_t* out = parts.frames.data();
   const uint64_t frames = parts.frame_count;
   size_t pos = 0;
   for (size_t ch = 0; ch < parts.channels.size(); ++ch) {
     const internal::SourceChannel& t = parts.channels[ch];
+    if (kinds_[ch] == internal::Stored::quat_y || kinds_[ch] == internal::Stored::quat_z) {  // x's frames
+      const internal::SourceChannel& x = parts.channels[ch - (kinds_[ch] == internal::Stored::quat_y ? 1 : 2)];
+      std::copy_n(out + x.first_key, t.key_count, out + t.first_key);
+      continue;
+    }
     uint64_t frame = 0;
     for (uint32_t i = 0; i < t.key_count; ++i) {
       const size_t at = pos;

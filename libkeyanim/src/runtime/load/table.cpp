@@ -58,9 +58,18 @@ Status Loader::read_header_and_table() {
   const size_t checksum_size = runtime_ ? internal::kRuntimeChecksumSize : internal::kChecksumSize;
   // A bank's member has no SKEL (section 10.5).
   const bool member = member_ != nullptr;
-  const uint32_t* critical_tags =
-      runtime_ ? internal::kRuntimeTags : member ? internal::kMemberTags : internal::kCriticalTags;
-  const size_t critical_count = runtime_ ? (member ? 2 : 3) : (member ? 4 : 5);
+  const bool v5 = major >= kQuatFormatVersionMajor && !runtime_;  // QUAT after SKEL (section 4.7)
+  const uint32_t* critical_tags = runtime_ ? internal::kRuntimeTags
+                                  : v5     ? (member ? internal::kMemberTagsV5 : internal::kCriticalTagsV5)
+                                           : (member ? internal::kMemberTags : internal::kCriticalTags);
+  const int* critical_slots = v5 ? (member ? internal::kMemberSlotsV5 : internal::kCriticalSlotsV5)
+                                 : member && !runtime_ ? internal::kMemberSlots : nullptr;
+  const size_t critical_count = runtime_ ? (member ? 2 : 3) : (member ? 4 : 5) + (v5 ? 1 : 0);
+  const char* const archive_rule =
+      v5 ? (member ? ": a member's critical sections must be CLIP, QUAT, CHAN, KTIM, KVAL, once each, in this order"
+                   : ": critical sections must be CLIP, SKEL, QUAT, CHAN, KTIM, KVAL, once each, in this order")
+         : (member ? ": a member's critical sections must be CLIP, CHAN, KTIM, KVAL, once each, in this order"
+                   : ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order");
   const std::string runtime_rule = member ? ": a runtime-profile member's sections must be CLIP and IMAG, entries 0 and 1"
                                           : ": the runtime profile's sections must be CLIP, IMAG and SKEL, entries 0, 1 and 2";
   if (avail < checksum_size ||
@@ -90,18 +99,15 @@ Status Loader::read_header_and_table() {
     if (runtime_ && (e.flags & internal::kSectionCompressed))
       return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": no section of the runtime profile is compressed");
     if (runtime_ && crit == critical_count && e.tag != internal::kTagNote)  // whatever its flags
-      for (uint32_t tag : internal::kCriticalTags)
+      for (uint32_t tag : internal::kCriticalTagsV5)
         if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
     if (runtime_ && i < critical_count && e.tag != critical_tags[i])
       return fail(Status::corrupt, "table", e.entry_offset, name + runtime_rule);
     if (crit < critical_count) {
       if (ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": a critical section marked ancillary");
       if (crit != next_critical || (runtime_ && i != crit))
-        return fail(Status::corrupt, "table", e.entry_offset,
-                    name + (runtime_  ? runtime_rule
-                            : member ? ": a member's critical sections must be CLIP, CHAN, KTIM, KVAL, once each, in this order"
-                                     : ": critical sections must be CLIP, SKEL, CHAN, KTIM, KVAL, once each, in this order"));
-      critical_index_[member && !runtime_ ? internal::kMemberSlots[crit] : static_cast<int>(crit)] = static_cast<int>(i);
+        return fail(Status::corrupt, "table", e.entry_offset, name + (runtime_ ? runtime_rule : archive_rule));
+      critical_index_[critical_slots ? critical_slots[crit] : static_cast<int>(crit)] = static_cast<int>(i);
       ++next_critical;
     } else if (e.tag == internal::kTagNote) {
       if (!ancillary) return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": NOTE must be ancillary");
@@ -258,7 +264,7 @@ Status Loader::get_skel(int index, Content& out) {
 
 Status Loader::check_declared_size(const TableEntry& e, int critical, const ClipSource& parts) {
   if (!(e.flags & kSectionCompressed)) return Status::ok;  // nothing to inflate: the parse checks
-  static const char* const kNames[5] = {"CLIP", "SKEL", "CHAN", "KTIM", "KVAL"};
+  static const char* const kNames[6] = {"CLIP", "SKEL", "CHAN", "KTIM", "KVAL", "QUAT"};
   Content c;  // where a failure is reported: the section's stored bytes, as after inflating
   c.name = kNames[critical];
   c.file_offset = e.file_offset;
@@ -279,9 +285,14 @@ Status Loader::check_declared_size(const TableEntry& e, int critical, const Clip
       break;
     }
     case 3:
-      if (key_count_ > raw) return fail_in(Status::corrupt, c, 0, "KTIM is too short for Key_Count varints");
-      if (raw > key_count_ * kMaxVarint32Bytes)
-        return fail_in(Status::corrupt, c, 0, "KTIM is longer than Key_Count varints of at most 5 bytes can be");
+      if (time_count_ > raw) return fail_in(Status::corrupt, c, 0, "KTIM is too short for its key frames' varints");
+      if (raw > time_count_ * kMaxVarint32Bytes)
+        return fail_in(Status::corrupt, c, 0, "KTIM is longer than its key frames' varints of at most 5 bytes can be");
+      break;
+    case kQuatSlot:
+      if (raw < kQuatHeaderBytes || (raw - kQuatHeaderBytes) % kQuatEntryBytes != 0 ||
+          (raw - kQuatHeaderBytes) / kQuatEntryBytes > node_count_)
+        return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 20 x Quat_Count bytes, Quat_Count at most Node_Count");
       break;
     default:
       if (major_ >= 3 && raw != kval_fixed_bytes(parts))

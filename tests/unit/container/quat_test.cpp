@@ -1,0 +1,194 @@
+// Rotations stored as quaternions (version 5, spec/FORMAT.md section 4.7): the container, both
+// profiles, the shared key frames of a node's x, y, z, and the rotation and Euler angles made
+// from them, each checked against an independent computation.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <vector>
+
+#include "clips.h"
+#include "crafted.h"
+#include "keyanim/offline/fk.h"
+#include "keyanim/rotation.h"
+
+using namespace container_test;
+using keyanim::QuatNode;
+using keyanim::Transform;
+
+namespace {
+
+constexpr double kRad = std::numbers::pi / 180.0;
+
+// The rotation angle between unit quaternions a and b (either sign), in radians: 4 asin of half
+// the chord, which keeps its digits for small angles (2 acos of the dot product does not).
+double angle_between(const double (&a)[4], const double (&b)[4]) {
+  const double sign = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0 ? -1.0 : 1.0;
+  double chord = 0.0;
+  for (int k = 0; k < 4; ++k) chord += (a[k] - sign * b[k]) * (a[k] - sign * b[k]);
+  return 4.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord)));
+}
+
+// R = R_axes[0](deg[0]) R_axes[1](deg[1]) R_axes[2](deg[2]) as a quaternion, by the offline FK's
+// axis quaternions (not by the code under test).
+void compose(const uint8_t (&axes)[3], const double (&deg)[3], double (&q)[4]) {
+  keyanim::offline::Quat r{0, 0, 0, 1};
+  for (int k = 0; k < 3; ++k) r = keyanim::offline::quat_multiply(r, keyanim::offline::axis_quaternion(axes[k], deg[k]));
+  for (int k = 0; k < 4; ++k) q[k] = r[k];
+}
+
+std::vector<uint8_t> aligned_copy(const std::vector<uint8_t>& bytes, std::vector<uint64_t>& words) {
+  words.assign((bytes.size() + 7) / 8, 0);
+  std::memcpy(words.data(), bytes.data(), bytes.size());
+  return bytes;
+}
+
+}  // namespace
+
+TEST_SUITE("container") {
+
+TEST_CASE("Euler angles of a quaternion recompose to it, for every axis order, and stay continuous") {
+  const uint8_t orders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  uint64_t s = 42;
+  for (const auto& axes : orders) {
+    CAPTURE(int(axes[0]) * 100 + int(axes[1]) * 10 + int(axes[2]));
+    for (int i = 0; i < 2000; ++i) {
+      // Random angles, a fifth of them at or next to gimbal lock.
+      double in[3];
+      for (double& a : in) a = double(lcg(s) % 3600000) / 10000.0 - 180.0;
+      if (i % 5 == 0) in[1] = (i % 10 == 0 ? 90.0 : -90.0) + (i % 3 == 0 ? 0.0 : 1e-9 * double(i % 7));
+      double q[4], deg[3], back[4];
+      compose(axes, in, q);
+      keyanim::euler_from_quaternion(q, axes, deg);
+      CHECK(deg[1] >= -90.0);
+      CHECK(deg[1] <= 90.0);
+      compose(axes, deg, back);
+      CHECK(angle_between(q, back) < 1e-9);
+      // Near the previous frame's angles, the nearest solution is within a small step of them.
+      double near[3] = {in[0] + 0.5, in[1] + 0.25, in[2] - 0.5};
+      double moved[3] = {deg[0], deg[1], deg[2]};
+      keyanim::nearest_euler(near, moved);
+      compose(axes, moved, back);
+      CHECK(angle_between(q, back) < 1e-9);
+      if (std::fabs(std::fabs(in[1]) - 90.0) > 1.0)  // away from gimbal lock: the input itself
+        for (int k = 0; k < 3; ++k) CHECK(std::fabs(moved[k] - in[k]) < 1e-6);
+    }
+  }
+}
+
+TEST_CASE("quaternion nodes round-trip through the archive and runtime profiles of version 5") {
+  const std::vector<EncodedClip> clips = {random_quat_clip(1, 500, 8), random_quat_clip(2, 301, 9, true),
+                                          random_quat_clip(3, 2, 3), random_quat_clip(4, 5000, 6),
+                                          random_quat_clip(5, 64, 5, true)};
+  for (const EncodedClip& e : clips) {
+    CAPTURE(e.frame_count);
+    REQUIRE_NOTHROW(keyanim::offline::validate_encoded_clip(e));
+    const std::vector<uint8_t> bytes = keyanim::offline::write_kanim(e);
+    const Loaded l = load(bytes);
+    REQUIRE_MESSAGE(l.status == Status::ok, l.err.section << " " << l.err.detail);
+    CHECK(l.clip.version_major() == keyanim::kQuatFormatVersionMajor);
+    REQUIRE(l.clip.quat_node_count() == e.quat_nodes.size());
+    for (uint32_t i = 0; i < e.quat_nodes.size(); ++i) {
+      const QuatNode n = l.clip.quat_node(i);
+      CHECK(n.node == e.quat_nodes[i].node);
+      CHECK(std::memcmp(n.reference, e.quat_nodes[i].reference, sizeof n.reference) == 0);
+      const uint32_t x = l.clip.skeleton().joints[n.node].first_channel + (n.node == 0 ? 3 : 0);
+      CHECK(l.clip.channel(x).stored == keyanim::StoredAs::quat_x);
+      CHECK(l.clip.channel(x + 1).stored == keyanim::StoredAs::quat_y);
+      CHECK(l.clip.channel(x + 2).stored == keyanim::StoredAs::quat_z);
+    }
+    const Clip ref = keyanim::offline::to_clip(e);
+    check_same_clip(l.clip, ref);
+    check_same_samples(l.clip, ref);
+    // The runtime profile, loaded and viewed where it lies, samples the same bits, and converts
+    // back to the very bytes of the archive file.
+    const std::vector<uint8_t> runtime = keyanim::offline::write_kanim_runtime(l.clip);
+    std::vector<uint64_t> words;
+    aligned_copy(runtime, words);
+    const std::span<const uint8_t> in_place(reinterpret_cast<const uint8_t*>(words.data()), runtime.size());
+    keyanim::DecodeLimits check;
+    check.check_content = true;
+    Clip loaded, viewed;
+    ErrorInfo err;
+    REQUIRE_MESSAGE(Clip::load(runtime, loaded, &err, check) == Status::ok, err.section << " " << err.detail);
+    REQUIRE_MESSAGE(Clip::view(in_place, viewed, &err, check) == Status::ok, err.section << " " << err.detail);
+    CHECK(viewed.version_major() == keyanim::kQuatFormatVersionMajor);
+    check_same_clip(viewed, ref);
+    check_same_samples(viewed, ref);
+    check_same_samples(loaded, viewed);
+    // (A single key comes back as q = +-1, step = |value|: spec section 9.3.)
+    CHECK(keyanim::offline::write_kanim(keyanim::offline::encoded_clip(viewed)) ==
+          keyanim::offline::write_kanim(keyanim::offline::encoded_clip(l.clip)));
+  }
+}
+
+TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its channels its Euler angles") {
+  const EncodedClip e = random_quat_clip(7, 300, 12, true);
+  const Clip clip = keyanim::offline::to_clip(e);
+  const uint32_t n = clip.channel_count();
+  std::vector<float> stored(n), angles(n);
+  std::vector<Transform> local(clip.skeleton().joints.size()), played(local.size());
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  double worst_pose = 0.0, worst_angles = 0.0;
+  for (double x = 0.0; x < 300.0; x += 0.37) {
+    REQUIRE(clip.sample_stored(x, stored) == Status::ok);
+    REQUIRE(clip.sample(x, angles) == Status::ok);
+    REQUIRE(clip.sample_local(x, local) == Status::ok);
+    REQUIRE(clip.sample_local(x, played, &cursor) == Status::ok);
+    CHECK(std::memcmp(local.data(), played.data(), local.size() * sizeof(Transform)) == 0);
+    for (const QuatNode& qn : e.quat_nodes) {
+      const keyanim::Joint& j = clip.skeleton().joints[qn.node];
+      const uint32_t c = j.first_channel;  // joints past the root: rotations only
+      // Independently: w rebuilt, the Hamilton product written out, normalized.
+      const double v[3] = {stored[c], stored[c + 1], stored[c + 2]};
+      const double w = std::sqrt(std::max(0.0, 1.0 - v[0] * v[0] - v[1] * v[1] - v[2] * v[2]));
+      const double r[4] = {qn.reference[0], qn.reference[1], qn.reference[2], qn.reference[3]};
+      double q[4] = {r[3] * v[0] + r[0] * w + r[1] * v[2] - r[2] * v[1], r[3] * v[1] - r[0] * v[2] + r[1] * w + r[2] * v[0],
+                     r[3] * v[2] + r[0] * v[1] - r[1] * v[0] + r[2] * w, r[3] * w - r[0] * v[0] - r[1] * v[1] - r[2] * v[2]};
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      for (double& k : q) k /= norm;
+      const double got[4] = {local[qn.node].rotation[0], local[qn.node].rotation[1], local[qn.node].rotation[2],
+                             local[qn.node].rotation[3]};
+      worst_pose = std::max(worst_pose, angle_between(q, got));
+      const uint8_t axes[3] = {uint8_t(keyanim::channel_axis(j.channels[0])), uint8_t(keyanim::channel_axis(j.channels[1])),
+                               uint8_t(keyanim::channel_axis(j.channels[2]))};
+      const double deg[3] = {angles[c], angles[c + 1], angles[c + 2]};
+      double back[4];
+      compose(axes, deg, back);
+      worst_angles = std::max(worst_angles, angle_between(q, back));
+    }
+  }
+  CHECK(worst_pose < 2e-6);    // binary32 arithmetic
+  CHECK(worst_angles < 2e-6);  // angles rounded to binary32 degrees
+  CHECK(worst_angles > 0.0);
+}
+
+TEST_CASE("the writer refuses quaternion nodes that break section 4.7") {
+  using keyanim::offline::validate_encoded_clip;
+  auto refused = [](EncodedClip e, const char* why) {
+    CAPTURE(why);
+    CHECK_THROWS(validate_encoded_clip(e));
+  };
+  const EncodedClip good = random_quat_clip(9, 100, 4);
+  REQUIRE_NOTHROW(validate_encoded_clip(good));
+  EncodedClip e = good;
+  e.quat_nodes[1].reference[3] *= 1.01f;
+  refused(e, "reference not unit");
+  e = good;
+  std::swap(e.quat_nodes[0], e.quat_nodes[1]);
+  refused(e, "nodes not increasing");
+  e = good;
+  e.quat_nodes.push_back({4, {0, 0, 0, 1}});  // the End Site
+  refused(e, "a node without rotation channels");
+  e = good;
+  const uint32_t c = e.skeleton.joints[1].first_channel;
+  e.channels[c + 1].frames.back() -= 1;
+  refused(e, "y's key frames differ from x's");
+  e = good;
+  e.channels[c + 2].interp = e.channels[c].interp == kLin ? kCard : kLin;
+  refused(e, "z's interpolation differs");
+}
+
+}  // TEST_SUITE
