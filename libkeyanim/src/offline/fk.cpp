@@ -45,6 +45,9 @@ struct Lanes2 {
 inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return Lanes2(_mm_add_pd(a.v, b.v)); }
 inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return Lanes2(_mm_sub_pd(a.v, b.v)); }
 inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return Lanes2(_mm_mul_pd(a.v, b.v)); }
+inline Lanes2 operator/(Lanes2 a, Lanes2 b) { return Lanes2(_mm_div_pd(a.v, b.v)); }
+inline Lanes2 sqrt_of(Lanes2 a) { return Lanes2(_mm_sqrt_pd(a.v)); }
+inline Lanes2 max0(Lanes2 a) { return Lanes2(_mm_max_pd(a.v, _mm_setzero_pd())); }  // a > 0 ? a : 0, as max0(double)
 #else
 struct Lanes2 {
   double x[2];
@@ -57,6 +60,9 @@ struct Lanes2 {
 inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.x[0] + b.x[0], a.x[1] + b.x[1]}; }
 inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.x[0] - b.x[0], a.x[1] - b.x[1]}; }
 inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.x[0] * b.x[0], a.x[1] * b.x[1]}; }
+inline Lanes2 operator/(Lanes2 a, Lanes2 b) { return {a.x[0] / b.x[0], a.x[1] / b.x[1]}; }
+inline Lanes2 sqrt_of(Lanes2 a) { return {std::sqrt(a.x[0]), std::sqrt(a.x[1])}; }
+inline Lanes2 max0(Lanes2 a) { return {max0(a.x[0]), max0(a.x[1])}; }
 #endif
 
 }  // namespace
@@ -132,6 +138,7 @@ namespace {
 struct OneRow {
   using D = double;
   const double* row;
+  const QuatForms* quats = nullptr;
   D value(uint32_t column) const noexcept { return row[column]; }
   void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg(row[column], s, c); }
 };
@@ -140,6 +147,7 @@ struct GivenSinCos {
   const double* row;
   const double* sines;
   const double* cosines;
+  const QuatForms* quats = nullptr;
   D value(uint32_t column) const noexcept { return row[column]; }
   void sin_cos(uint32_t column, D& s, D& c) const noexcept { s = sines[column], c = cosines[column]; }
 };
@@ -147,9 +155,26 @@ struct TwoRows {
   using D = Lanes2;
   const double* a;
   const double* b;
+  const QuatForms* quats = nullptr;
   D value(uint32_t column) const noexcept { return {a[column], b[column]}; }
   void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg2(value(column), s, c); }
 };
+
+}  // namespace
+
+QuatForms::QuatForms(const Skeleton& skeleton, const std::vector<QuatNode>& nodes)
+    : of_node(skeleton.joints.size(), -1) {
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const QuatNode& n = nodes[i];
+    uint32_t first = 0;
+    quaternion_capable(skeleton.joints[n.node], &first);
+    of_node[n.node] = int32_t(i);
+    reference.push_back({n.reference[0], n.reference[1], n.reference[2], n.reference[3]});
+    column.push_back(skeleton.joints[n.node].first_channel + first);
+  }
+}
+
+namespace {
 
 }  // namespace
 
@@ -217,7 +242,7 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const ui
 
 void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
                   PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
-                  std::vector<Vec3>* add_a, std::vector<Vec3>* add_b) {
+                  std::vector<Vec3>* add_a, std::vector<Vec3>* add_b, const QuatForms* quats) {
   thread_local std::vector<std::array<Lanes2, 9>> rotations;
   thread_local std::vector<std::array<Lanes2, 3>> positions, positions_add;
   const size_t n = skeleton.joints.size();
@@ -226,7 +251,7 @@ void world_points(const Skeleton& skeleton, const double* row_a, const double* r
   if (both && positions_add.size() < n) positions_add.resize(n);
   out_a.resize(4 * n), out_b.resize(4 * n);
   if (both) add_a->resize(4 * n), add_b->resize(4 * n);
-  pose_frame(skeleton, TwoRows{row_a, row_b}, positions.data(), rotations.data(), nodes, reading,
+  pose_frame(skeleton, TwoRows{row_a, row_b, quats}, positions.data(), rotations.data(), nodes, reading,
              both ? positions_add.data() : nullptr);
   const Lanes2 d(distance);
   auto points = [&](const std::array<Lanes2, 3>& p, const std::array<Lanes2, 9>& r, size_t j, Vec3* a, Vec3* b) {
@@ -247,18 +272,19 @@ void world_points(const Skeleton& skeleton, const double* row_a, const double* r
 
 void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
                   PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out,
-                  std::array<std::vector<Vec3>, 4>* out_add) {
+                  std::array<std::vector<Vec3>, 4>* out_add, const QuatForms* quats) {
   if (internal::cpu_level() == internal::CpuLevel::v3) {
     Vec3* points[4];
     Vec3* points_add[4];
     for (size_t i = 0; i < 4; ++i) out[i].resize(4 * skeleton.joints.size()), points[i] = out[i].data();
     if (out_add)
       for (size_t i = 0; i < 4; ++i) (*out_add)[i].resize(4 * skeleton.joints.size()), points_add[i] = (*out_add)[i].data();
-    if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points, out_add ? points_add : nullptr)) return;
+    if (world_points_v3(skeleton, rows.data(), nodes, reading, distance, points, out_add ? points_add : nullptr, quats))
+      return;
   }
   auto add = [&](size_t i) { return out_add ? &(*out_add)[i] : nullptr; };
-  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1], add(0), add(1));
-  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3], add(2), add(3));
+  world_points(skeleton, rows[0], rows[1], nodes, reading, distance, out[0], out[1], add(0), add(1), quats);
+  world_points(skeleton, rows[2], rows[3], nodes, reading, distance, out[2], out[3], add(2), add(3), quats);
 }
 
 void world_positions(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,

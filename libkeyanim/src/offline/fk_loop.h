@@ -6,6 +6,7 @@
 // could run AVX code on a machine without it).
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <numbers>
@@ -19,7 +20,8 @@ namespace keyanim::offline {
 // 4 x the nodes, and under the add reading into out_add[0..4) when it is not null; false, with
 // nothing done, where this build has no AVX2 copy (not x86-64). The caller checks the CPU.
 bool world_points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes,
-                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add);
+                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add,
+                     const QuatForms* quats);
 
 namespace {
 
@@ -33,6 +35,9 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // Developed at SunPro, a Sun Microsystems, Inc. business.
 // Permission to use, copy, modify, and distribute this software is freely granted, provided
 // that this notice is preserved.
+inline double sqrt_of(double x) noexcept { return std::sqrt(x); }
+inline double max0(double x) noexcept { return x > 0.0 ? x : 0.0; }
+
 template <class D>  // double, or a lane type: the same operations on each lane
 inline void kernel_sin_cos(D x, D& s, D& c) noexcept {
   constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
@@ -92,9 +97,33 @@ inline void place(std::array<D, 3>* pos, size_t j, int32_t parent, const std::ar
             pp[2] + m[6] * t[0] + m[7] * t[1] + m[8] * t[2]};
 }
 
+// m = m * R(q) for a quaternion node (QuatForms): q from its stored x, y, z as keyanim/
+// rotation.h computes it, in binary64 (sqrt_of and max0 are D's), then its rotation matrix.
+template <class D, class Values>
+inline void post_rotate_quat(std::array<D, 9>& m, const Values& values, const QuatForms& quats, int32_t i) noexcept {
+  const std::array<double, 4>& r = quats.reference[size_t(i)];
+  const D ref[4] = {D(r[0]), D(r[1]), D(r[2]), D(r[3])};
+  const uint32_t c = quats.column[size_t(i)];
+  D q[4];
+  stored_rotation<D>(ref, values.value(c), values.value(c + 1), values.value(c + 2), q,
+                     [](D x) { return sqrt_of(x); }, [](D x) { return max0(x); });
+  const D one(1.0), two(2.0);
+  const D xx = q[0] * q[0], yy = q[1] * q[1], zz = q[2] * q[2];
+  const D xy = q[0] * q[1], xz = q[0] * q[2], yz = q[1] * q[2], xw = q[0] * q[3], yw = q[1] * q[3], zw = q[2] * q[3];
+  const D b[9] = {one - two * (yy + zz), two * (xy - zw),       two * (xz + yw),
+                  two * (xy + zw),       one - two * (xx + zz), two * (yz - xw),
+                  two * (xz - yw),       two * (yz + xw),       one - two * (xx + yy)};
+  const std::array<D, 9> a = m;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col)
+      m[size_t(3 * row + col)] = (a[size_t(3 * row)] * b[col] + a[size_t(3 * row + 1)] * b[3 + col]) +
+                                 a[size_t(3 * row + 2)] * b[6 + col];
+}
+
 // The one FK loop everything else uses, on one frame (double) or several in SIMD lanes. `values`
 // gives a channel's value (value(column)) and the sine and cosine of a rotation's
-// (sin_cos(column, s, c)), as D. pos and rot have room for every node. With `nodes`, only the nodes it marks (a set holding every ancestor of
+// (sin_cos(column, s, c)), as D, and its `quats` (null, or a clip's quaternion nodes, whose
+// rotation channels hold stored x, y, z). pos and rot have room for every node. With `nodes`, only the nodes it marks (a set holding every ancestor of
 // its members) are computed. With `pos_add`, the positions under the add reading go there as
 // well (`reading` then says replace): the rotations, most of the work, do not depend on the
 // reading, so both readings cost one pass, each position the same operations as its own pass.
@@ -115,10 +144,13 @@ void pose_frame_readings(const Skeleton& skeleton, const Values& values, std::ar
     if constexpr (kBoth) t_add = t;
     std::array<D, 9>& r = rot[j];
     r = parent_rot;
+    const int32_t quat = values.quats ? values.quats->of_node[j] : -1;
+    if (quat >= 0) post_rotate_quat(r, values, *values.quats, quat);
     for (size_t k = 0; k < joint.channels.size(); ++k) {
       const ChannelType type = joint.channels[k];
       const uint32_t column = joint.first_channel + uint32_t(k);
       if (is_rotation(type)) {
+        if (quat >= 0) continue;
         D sn, cs;
         values.sin_cos(column, sn, cs);
         post_rotate(r, channel_axis(type), sn, cs);

@@ -25,6 +25,9 @@ struct Lanes4 {
 inline Lanes4 operator+(Lanes4 a, Lanes4 b) { return Lanes4(_mm256_add_pd(a.v, b.v)); }
 inline Lanes4 operator-(Lanes4 a, Lanes4 b) { return Lanes4(_mm256_sub_pd(a.v, b.v)); }
 inline Lanes4 operator*(Lanes4 a, Lanes4 b) { return Lanes4(_mm256_mul_pd(a.v, b.v)); }
+inline Lanes4 operator/(Lanes4 a, Lanes4 b) { return Lanes4(_mm256_div_pd(a.v, b.v)); }
+inline Lanes4 sqrt_of(Lanes4 a) { return Lanes4(_mm256_sqrt_pd(a.v)); }
+inline Lanes4 max0(Lanes4 a) { return Lanes4(_mm256_max_pd(a.v, _mm256_setzero_pd())); }  // a > 0 ? a : 0
 
 // sin_cos_deg of each lane, bit for bit (fk.cpp's sin_cos_deg2 on four lanes). Angles of 10^9
 // degrees or more (or NaN) take the scalar path: below that the quadrant fits a 32-bit integer.
@@ -60,6 +63,7 @@ inline void sin_cos_deg4(Lanes4 deg, Lanes4& s, Lanes4& c) noexcept {
 struct FourRows {
   using D = Lanes4;
   const double* const* rows;
+  const QuatForms* quats = nullptr;
   D value(uint32_t column) const noexcept { return {rows[0][column], rows[1][column], rows[2][column], rows[3][column]}; }
   void sin_cos(uint32_t column, D& s, D& c) const noexcept { sin_cos_deg4(value(column), s, c); }
 };
@@ -70,13 +74,13 @@ namespace {
 
 template <bool kBoth>
 void points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes, PositionReading reading,
-               double distance, Vec3* const* out, Vec3* const* out_add) {
+               double distance, Vec3* const* out, Vec3* const* out_add, const QuatForms* quats) {
   thread_local std::vector<std::array<Lanes4, 9>> rotations;
   thread_local std::vector<std::array<Lanes4, 3>> positions, positions_add;
   const size_t n = skeleton.joints.size();
   if (rotations.size() < n) rotations.resize(n), positions.resize(n);
   if (kBoth && positions_add.size() < n) positions_add.resize(n);
-  pose_frame(skeleton, FourRows{rows}, positions.data(), rotations.data(), nodes, reading,
+  pose_frame(skeleton, FourRows{rows, quats}, positions.data(), rotations.data(), nodes, reading,
              kBoth ? positions_add.data() : nullptr);
   const Lanes4 d(distance);
   alignas(32) double lanes[4];
@@ -107,16 +111,17 @@ void points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_
 }  // namespace
 
 bool world_points_v3(const Skeleton& skeleton, const double* const* rows, const uint8_t* nodes,
-                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add) {
-  if (out_add) points_v3<true>(skeleton, rows, nodes, reading, distance, out, out_add);
-  else points_v3<false>(skeleton, rows, nodes, reading, distance, out, nullptr);
+                     PositionReading reading, double distance, Vec3* const* out, Vec3* const* out_add,
+                     const QuatForms* quats) {
+  if (out_add) points_v3<true>(skeleton, rows, nodes, reading, distance, out, out_add, quats);
+  else points_v3<false>(skeleton, rows, nodes, reading, distance, out, nullptr, quats);
   return true;
 }
 
 #else
 
 bool world_points_v3(const Skeleton&, const double* const*, const uint8_t*, PositionReading, double,
-                     Vec3* const*, Vec3* const*) {
+                     Vec3* const*, Vec3* const*, const QuatForms*) {
   return false;
 }
 

@@ -72,8 +72,9 @@ void measured_points(const Skeleton& skeleton, const double* row_a, const double
 
 void measured_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, double shell,
                      PositionReading reading, std::array<std::vector<std::array<double, 3>>, 4>& points,
-                     const uint8_t* nodes, std::array<std::vector<std::array<double, 3>>, 4>* points_add) {
-  world_points(skeleton, rows, nodes, reading, shell, points, points_add);  // node_points, four at once
+                     const uint8_t* nodes, std::array<std::vector<std::array<double, 3>>, 4>* points_add,
+                     const QuatForms* quats) {
+  world_points(skeleton, rows, nodes, reading, shell, points, points_add, quats);  // node_points, four at once
 }
 
 std::string point_name(const Skeleton& s, uint32_t node, uint32_t point) {

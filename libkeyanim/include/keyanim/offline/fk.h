@@ -25,12 +25,28 @@
 
 #include "keyanim/offline/motion.h"
 #include "keyanim/pose.h"
+#include "keyanim/rotation.h"
 
 namespace keyanim::offline {
 
 using Vec3 = std::array<double, 3>;
 using Mat3 = std::array<double, 9>;  // row-major
 using Quat = std::array<double, 4>;  // x, y, z, w (glTF's and keyanim::Transform's order)
+
+// A clip's quaternion nodes (spec section 4.7), for FK of its stored values (the encoder's
+// verification): such a node's rotation channels hold x, y, z of its rotation relative to its
+// reference, and its rotation is keyanim/rotation.h's stored_rotation in binary64, not the
+// product of Euler angles. Per node, the index of its QuatNode (-1: Euler channels); per
+// QuatNode, its reference widened to binary64 and the column of its x.
+struct QuatForms {
+  std::vector<int32_t> of_node;
+  std::vector<std::array<double, 4>> reference;
+  std::vector<uint32_t> column;
+  QuatForms() = default;
+  // `nodes` follow section 4.7 (increasing, each quaternion_capable); channel columns assigned.
+  QuatForms(const Skeleton& skeleton, const std::vector<QuatNode>& nodes);
+  bool empty() const noexcept { return reference.empty(); }
+};
 
 // Rotation matrix of one joint from its channel values (frame row), Euler order as listed.
 Mat3 local_rotation(const Joint& joint, const double* frame_row);
@@ -64,15 +80,17 @@ void world_positions(const Skeleton& skeleton, const double* row_a, const double
 // what world_pose gives, bit for bit.
 // With add_a and add_b (`reading` replace), the points under the add reading too, bit for bit a
 // second call with it: the rotations are computed once for both.
+// With `quats`, rows of a clip's stored values (QuatForms).
 void world_points(const Skeleton& skeleton, const double* row_a, const double* row_b, const uint8_t* nodes,
                   PositionReading reading, double distance, std::vector<Vec3>& out_a, std::vector<Vec3>& out_b,
-                  std::vector<Vec3>* add_a = nullptr, std::vector<Vec3>* add_b = nullptr);
+                  std::vector<Vec3>* add_a = nullptr, std::vector<Vec3>* add_b = nullptr,
+                  const QuatForms* quats = nullptr);
 // Four frame rows at once, into out[0..4) (and out_add, as above): bit for bit what the above
 // gives for rows 0 and 1, then 2 and 3; in four AVX lanes on x86-64-v3 machines
 // (internal/cpu.h; KEYANIM_CPU caps it).
 void world_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, const uint8_t* nodes,
                   PositionReading reading, double distance, std::array<std::vector<Vec3>, 4>& out,
-                  std::array<std::vector<Vec3>, 4>* out_add = nullptr);
+                  std::array<std::vector<Vec3>, 4>* out_add = nullptr, const QuatForms* quats = nullptr);
 
 // The same, with the sine and cosine of every rotation channel given (sin_cos_deg of the
 // row's value, at the channel's column): for callers that re-pose frames in which few values

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "keyanim/offline/error.h"
+#include "keyanim/offline/fk.h"
 #include "keyanim/offline/motion.h"
 #include "keyanim/pose.h"
 
@@ -70,10 +71,12 @@ void measured_points(const Skeleton& skeleton, const double* row_a, const double
                      std::vector<std::array<double, 3>>* add_b = nullptr);
 // Four frame rows at once (bit for bit two calls of the above, on rows 0 and 1, then 2 and 3;
 // faster still where the CPU has AVX2): two frames, original and decoded.
+// With `quats`, the rows are a clip's stored values (fk.h's QuatForms).
 void measured_points(const Skeleton& skeleton, const std::array<const double*, 4>& rows, double shell,
                      PositionReading reading, std::array<std::vector<std::array<double, 3>>, 4>& points,
                      const uint8_t* nodes = nullptr,
-                     std::array<std::vector<std::array<double, 3>>, 4>* points_add = nullptr);
+                     std::array<std::vector<std::array<double, 3>>, 4>* points_add = nullptr,
+                     const QuatForms* quats = nullptr);
 // How many of a node's points are measured (1 or kPointsPerNode).
 inline uint32_t measured_point_count(const Joint& node, double shell) noexcept {
   return shell > 0.0 && !node.end_site ? kPointsPerNode : 1;

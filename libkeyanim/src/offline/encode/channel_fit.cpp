@@ -68,6 +68,43 @@ constexpr uint32_t kShortSegment = 8;  // shorter segments skip the vectorized l
   return worst;
 }
 
+// A quaternion node's error at frame f (QuatCurve): the chord between its relative rotation
+// y[0..3][f] and the decoded one, x, y, z as evaluated (binary32) with w rebuilt and the whole
+// normalized in binary64 (keyanim/rotation.h's arithmetic: the reference turns both alike).
+[[gnu::always_inline]] inline double quat_chord(const std::array<const double*, 4>& y, uint32_t f, float x, float yy,
+                                                float z) {
+  const double dx = x, dy = yy, dz = z;
+  const double n2 = (dx * dx + dy * dy) + dz * dz;
+  const double w = n2 < 1.0 ? std::sqrt(1.0 - n2) : 0.0;
+  const double scale = n2 > 1.0 ? 1.0 / std::sqrt(n2) : 1.0;  // (x, y, z, 0) normalized
+  const double ex = dx * scale - y[0][f], ey = dy * scale - y[1][f], ez = dz * scale - y[2][f], ew = w - y[3][f];
+  return std::sqrt(ex * ex + ey * ey + ez * ez + ew * ew);
+}
+
+// worst_ratio for a quaternion node's segment: the largest chord / tolerance over the frames
+// strictly inside [start, end], and the first frame that has it.
+double worst_chord(const std::array<const double*, 4>& y, const Tolerance& tol, const SegmentOperands* ops,
+                   uint32_t start, uint32_t end, uint32_t& arg) {
+  double worst = 0.0;
+  arg = start + 1;
+  for (uint32_t f = start + 1; f < end; ++f) {
+    const float u = segment_u(start, end, float(f));
+    const double r = quat_chord(y, f, eval_operands(ops[0], u), eval_operands(ops[1], u), eval_operands(ops[2], u)) /
+                     tol.at(f);
+    if (r > worst) worst = r, arg = f;
+  }
+  return worst;
+}
+
+// The worst ratio of a segment of `Kind` (ops: one per curve).
+template <class Kind>
+[[gnu::always_inline]] inline double segment_worst(const std::array<const double*, Kind::kSignals>& y, const Tolerance& tol,
+                                                   const SegmentOperands* ops, uint32_t start, uint32_t end,
+                                                   uint32_t& arg) {
+  if constexpr (Kind::kCurves == 1) return worst_ratio(y[0], tol, ops[0], start, end, arg);
+  else return worst_chord(y, tol, ops, start, end, arg);
+}
+
 // The segments a refit re-measures after its tolerances tightened at `changed` frames
 // (sorted): visit(i) for each segment [keys[i], keys[i + 1]] that holds one of them, or that
 // ends at one (a key's tolerance bounds the fit of the segment before it), once each, in
@@ -89,19 +126,23 @@ bool for_each_changed_segment(const std::vector<uint32_t>& keys, const std::vect
 
 }  // namespace
 
-void FitScratch::prepare(size_t frames) {
+void FitScratch::prepare(size_t frames, uint32_t curves) {
+  for (uint32_t k = 0; k < curves; ++k)
+    if (v[k].size() != frames) v[k].assign(frames, 0.0f);
   if (prev.size() == frames) return;
   prev.assign(frames, CurveFit::kNone), next.assign(frames, CurveFit::kNone), is_key.assign(frames, 0);
-  v.assign(frames, 0.0f), seg_ratio.assign(frames, 0.0), seg_arg.assign(frames, 0);
+  seg_ratio.assign(frames, 0.0), seg_arg.assign(frames, 0);
 }
 
-CurveFit::CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule,
-                   FitScratch& scratch)
+template <class Kind>
+CurveFitT<Kind>::CurveFitT(Signals y, uint32_t frames, Interpolation interp, float s, TangentRule rule,
+                           FitScratch& scratch)
     : y_(y), interp_(interp), s_(s), rule_(rule), w_(scratch) {
-  w_.prepare(frames);
+  w_.prepare(frames, kCurves);
 }
 
-CurveFit::~CurveFit() {
+template <class Kind>
+CurveFitT<Kind>::~CurveFitT() {
   // Unlinking as we go leaves every frame as prepare() made it.
   for (uint32_t f = first_; f != kNone;) {
     const uint32_t next = w_.next[f];
@@ -110,7 +151,8 @@ CurveFit::~CurveFit() {
   }
 }
 
-void CurveFit::link_keys(const std::vector<uint32_t>& keys) {
+template <class Kind>
+void CurveFitT<Kind>::link_keys(const std::vector<uint32_t>& keys) {
   first_ = keys.empty() ? kNone : keys.front();
   count_ = keys.size();
   for (size_t i = 0; i < keys.size(); ++i) {
@@ -122,7 +164,8 @@ void CurveFit::link_keys(const std::vector<uint32_t>& keys) {
   }
 }
 
-void CurveFit::reset(const std::vector<uint32_t>& keys, Tolerance tol, double step) {
+template <class Kind>
+void CurveFitT<Kind>::reset(const std::vector<uint32_t>& keys, Tolerance tol, double step) {
   tol_ = tol;
   step_ = step;
   recent_.clear();
@@ -131,7 +174,8 @@ void CurveFit::reset(const std::vector<uint32_t>& keys, Tolerance tol, double st
   measure_all();
 }
 
-void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double step, double previous_step,
+template <class Kind>
+void CurveFitT<Kind>::resume(const std::vector<uint32_t>& keys, Tolerance tol, double step, double previous_step,
                       const std::vector<uint32_t>* changed) {
   tol_ = tol;
   step_ = step;
@@ -147,39 +191,51 @@ void CurveFit::resume(const std::vector<uint32_t>& keys, Tolerance tol, double s
   });
 }
 
-void CurveFit::quantize_at(uint32_t f) { w_.v[f] = key_value(y_[f], step_); }
+template <class Kind>
+void CurveFitT<Kind>::quantize_at(uint32_t f) {
+  for (uint32_t k = 0; k < kCurves; ++k) w_.v[k][f] = key_value(y_[k][f], step_);
+}
 
-void CurveFit::measure_all() {
+template <class Kind>
+void CurveFitT<Kind>::measure_all() {
   heap_ = {};
   all_measured_ = true;
   for (uint32_t f = first_; f != kNone && w_.next[f] != kNone; f = w_.next[f]) measure(f);
 }
 
-void CurveFit::measure(uint32_t start, bool push) {
+template <class Kind>
+void CurveFitT<Kind>::measure(uint32_t start, bool push) {
   // The decoder's arithmetic on the (up to) four keys around the segment [start, end]: the
   // same end-point duplication as eval_segment applies where the list ends.
   const uint32_t end = w_.next[start], p = w_.prev[start], n = w_.next[end];
-  const Key before{p, p != kNone ? w_.v[p] : 0.0f}, after{n, n != kNone ? w_.v[n] : 0.0f};
-  const SegmentOperands ops = window_operands(p != kNone ? &before : nullptr, {start, w_.v[start]},
-                                              {end, w_.v[end]}, n != kNone ? &after : nullptr, interp_, s_, rule_);
+  SegmentOperands ops[kCurves];
+  for (uint32_t k = 0; k < kCurves; ++k) {
+    const std::vector<float>& v = w_.v[k];
+    const Key before{p, p != kNone ? v[p] : 0.0f}, after{n, n != kNone ? v[n] : 0.0f};
+    ops[k] = window_operands(p != kNone ? &before : nullptr, {start, v[start]}, {end, v[end]},
+                             n != kNone ? &after : nullptr, interp_, s_, rule_);
+  }
   uint32_t arg = 0;
-  const double worst = worst_ratio(y_, tol_, ops, start, end, arg);
+  const double worst = segment_worst<Kind>(y_, tol_, ops, start, end, arg);
   w_.seg_ratio[start] = worst, w_.seg_arg[start] = arg;
   if (push && worst > 1.0) heap_.push({worst, start, end});
 }
 
-void CurveFit::link(uint32_t f, uint32_t a, uint32_t b) {
+template <class Kind>
+void CurveFitT<Kind>::link(uint32_t f, uint32_t a, uint32_t b) {
   w_.is_key[f] = 1, w_.prev[f] = a, w_.next[f] = b, w_.next[a] = f, w_.prev[b] = f;
   ++count_;
 }
 
-void CurveFit::unlink(uint32_t f) {
+template <class Kind>
+void CurveFitT<Kind>::unlink(uint32_t f) {
   const uint32_t a = w_.prev[f], b = w_.next[f];
   w_.next[a] = b, w_.prev[b] = a, w_.is_key[f] = 0, w_.prev[f] = w_.next[f] = kNone;
   --count_;
 }
 
-void CurveFit::refine() {
+template <class Kind>
+void CurveFitT<Kind>::refine() {
   while (!heap_.empty()) {
     const Entry e = heap_.top();
     heap_.pop();
@@ -196,12 +252,14 @@ void CurveFit::refine() {
   }
 }
 
-void CurveFit::measure_neighbour(uint32_t start) {
+template <class Kind>
+void CurveFitT<Kind>::measure_neighbour(uint32_t start) {
   if (!neighbours_stand()) return measure(start);
   if (w_.seg_ratio[start] > 1.0) heap_.push({w_.seg_ratio[start], start, w_.next[start]});  // as measure() would
 }
 
-void CurveFit::prune() {
+template <class Kind>
+void CurveFitT<Kind>::prune() {
   if (first_ == kNone) return;
   if (prune_all_) {
     for (uint32_t f = w_.next[first_]; f != kNone && w_.next[f] != kNone;) {
@@ -223,7 +281,8 @@ void CurveFit::prune() {
 }
 
 // Removes interior key f if every segment it affects stays within tolerance without it.
-bool CurveFit::try_remove(uint32_t f) {
+template <class Kind>
+bool CurveFitT<Kind>::try_remove(uint32_t f) {
   // Without f, the segments starting at p = prev(a), a and b change; f's own disappears.
   const uint32_t a = w_.prev[f], b = w_.next[f], p = w_.prev[a];
   const uint32_t starts[4] = {p, a, f, b};
@@ -245,11 +304,13 @@ bool CurveFit::try_remove(uint32_t f) {
   return false;
 }
 
-float CurveFit::best_s() const {
+template <class Kind>
+float CurveFitT<Kind>::best_s() const requires(Kind::kCurves == 1) {
   double num = 0.0, den = 0.0;
   const auto& next = w_.next;
   const auto& prev = w_.prev;
-  const auto& val = w_.v;
+  const auto& val = w_.v[0];
+  const double* y = y_[0];
   for (uint32_t a = first_; a != kNone && next[a] != kNone; a = next[a]) {
     const uint32_t b = next[a], pm = prev[a] != kNone ? prev[a] : a, c = next[b] != kNone ? next[b] : b;
     const double p0 = val[a], p1 = val[b], vm = val[pm], p2 = val[c];
@@ -263,7 +324,7 @@ float CurveFit::best_s() const {
       const double u = (f - a) / len, u2 = u * u, u3 = u2 * u;
       const double base = (2 * u3 - 3 * u2 + 1) * p0 + (-2 * u3 + 3 * u2) * p1;
       const double slope = (u3 - 2 * u2 + u) * a0 * (p1 - vm) + (u3 - u2) * a1 * (p2 - p0);
-      num += slope * (y_[f] - base);
+      num += slope * (y[f] - base);
       den += slope * slope;
     }
   }
@@ -271,7 +332,8 @@ float CurveFit::best_s() const {
   return float(std::clamp(num / den, 0.0, 1.0));
 }
 
-std::vector<uint32_t> CurveFit::take_keys() {
+template <class Kind>
+std::vector<uint32_t> CurveFitT<Kind>::take_keys() {
   std::vector<uint32_t> out(count_);
   size_t i = 0;
   for (uint32_t f = first_; f != kNone; ++i) {
@@ -284,6 +346,9 @@ std::vector<uint32_t> CurveFit::take_keys() {
   return out;
 }
 
+template class CurveFitT<ChannelCurve>;
+template class CurveFitT<QuatCurve>;
+
 namespace {
 
 std::vector<uint32_t> end_keys(size_t frames) {
@@ -293,15 +358,27 @@ std::vector<uint32_t> end_keys(size_t frames) {
 }
 
 EncodedChannel channel_at(const double* y, Interpolation interp, float tension, double step,
-                          std::vector<uint32_t> keys) {
+                          const std::vector<uint32_t>& keys) {
   EncodedChannel ch;
   ch.interp = interp;
   ch.tension = tension;
   ch.step = step;
   ch.q.resize(keys.size());
   for (size_t i = 0; i < keys.size(); ++i) ch.q[i] = quantize(y[keys[i]], step);
-  ch.frames = std::move(keys);
+  ch.frames = keys;
   return ch;
+}
+
+// A fit's result at `keys`: the channel, or a quaternion node's three.
+template <class Kind>
+typename CurveFitter<Kind>::Result result_at(const typename CurveFitT<Kind>::Signals& y, Interpolation interp,
+                                             float tension, double step, const std::vector<uint32_t>& keys) {
+  if constexpr (Kind::kCurves == 1) {
+    return channel_at(y[0], interp, tension, step, keys);
+  } else {
+    return {channel_at(y[0], interp, tension, step, keys), channel_at(y[1], interp, tension, step, keys),
+            channel_at(y[2], interp, tension, step, keys)};
+  }
 }
 
 }  // namespace
@@ -330,6 +407,32 @@ std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames,
   return std::nullopt;
 }
 
+std::optional<std::array<EncodedChannel, 3>> constant_quat(const QuatFit::Signals& y, uint32_t frames,
+                                                           const double* lo, const double* hi, Tolerance tol,
+                                                           double step) {
+  // As constant_channel: no key (the reference itself) first, then one key at each curve's
+  // middle, with the largest power of two up to the step, then the step. The three curves
+  // share their key frames: all have the key, or none.
+  const double power_of_two = std::ldexp(1.0, std::ilogb(step));
+  auto within = [&](const float (&v)[3]) {
+    uint32_t f = 0;
+    while (f < frames && quat_chord(y, f, v[0], v[1], v[2]) <= tol.at(f)) ++f;
+    return f == frames;
+  };
+  std::array<EncodedChannel, 3> out;
+  for (EncodedChannel& ch : out) ch.step = power_of_two;
+  if (within({0.0f, 0.0f, 0.0f})) return out;
+  for (const double s : {power_of_two, step}) {
+    int64_t q[3];
+    float v[3];
+    for (int k = 0; k < 3; ++k) q[k] = quantize(0.5 * (lo[k] + hi[k]), s), v[k] = dequantize(q[k], s);
+    if (!within(v)) continue;
+    for (int k = 0; k < 3; ++k) out[size_t(k)].frames = {0}, out[size_t(k)].q = {q[k]}, out[size_t(k)].step = s;
+    return out;
+  }
+  return std::nullopt;
+}
+
 EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys, Tolerance tol,
                                    double step, const ChannelFitOptions& opt, FitScratch& scratch) {
   const uint32_t n = uint32_t(y.size());
@@ -340,45 +443,75 @@ EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vect
   const Interpolation interp = opt.force_linear ? Interpolation::linear : Interpolation::cardinal;
   float tension = opt.tension;
   if (opt.fit_tension && !opt.force_linear) {
-    CurveFit curve(y.data(), n, interp, tension_to_s(opt.tension), opt.rule, scratch);
+    CurveFit curve({y.data()}, n, interp, tension_to_s(opt.tension), opt.rule, scratch);
     curve.reset(keys, tol, step);
     tension = s_to_tension(curve.best_s());
   }
   return channel_at(y.data(), interp, tension, step, keys);
 }
 
-EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<uint32_t>* changed,
-                                  FitScratch& scratch) {
-  const double* y = scratch.y.data();
-  const uint32_t n = uint32_t(scratch.y.size());
+std::array<EncodedChannel, 3> fit_quat_at_keys(const std::vector<uint32_t>& keys, Tolerance tol, double step,
+                                               const ChannelFitOptions& opt, FitScratch& scratch) {
+  const QuatFit::Signals y = scratch.signals<QuatCurve>();
+  const uint32_t n = uint32_t(scratch.q[0].size());
+  if (n > 0) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto [a, b] = std::minmax_element(scratch.q[size_t(k)].begin(), scratch.q[size_t(k)].end());
+      lo[k] = *a, hi[k] = *b;
+    }
+    if (auto c = constant_quat(y, n, lo, hi, tol, step)) return *c;
+  }
+  // No tension is fitted for three curves at once: the given one.
+  const Interpolation interp = opt.force_linear ? Interpolation::linear : Interpolation::cardinal;
+  return result_at<QuatCurve>(y, interp, opt.tension, step, keys);
+}
+
+template <class Kind>
+typename CurveFitter<Kind>::Result CurveFitter<Kind>::fit(Tolerance tol, double step,
+                                                          const std::vector<uint32_t>* changed, FitScratch& scratch) {
+  constexpr uint32_t kCurves = Kind::kCurves;
+  const typename CurveFitT<Kind>::Signals y = scratch.signals<Kind>();
+  const uint32_t n = uint32_t(kCurves == 1 ? scratch.y.size() : scratch.q[0].size());
   if (!have_extent_ && n > 0) {
-    const auto [lo, hi] = std::minmax_element(scratch.y.begin(), scratch.y.end());
-    lo_ = *lo, hi_ = *hi, have_extent_ = true;
+    for (uint32_t k = 0; k < kCurves; ++k) {
+      const auto [lo, hi] = std::minmax_element(y[k], y[k] + n);
+      lo_[k] = *lo, hi_[k] = *hi;
+    }
+    have_extent_ = true;
   }
   fitted_ = false;
-  if (auto c = constant_channel(y, n, lo_, hi_, tol, step)) return *c;
+  if constexpr (kCurves == 1) {
+    if (auto c = constant_channel(y[0], n, lo_[0], hi_[0], tol, step)) return *c;
+  } else {
+    if (auto c = constant_quat(y, n, lo_, hi_, tol, step)) return *c;
+  }
   if (candidates_.empty()) {
     const std::vector<uint32_t> ends = end_keys(n);
     auto add = [&](Interpolation interp, float tension, float* best_s = nullptr) {
-      CurveFit c(y, n, interp, tension_to_s(tension), opt_.rule, scratch);
+      CurveFitT<Kind> c(y, n, interp, tension_to_s(tension), opt_.rule, scratch);
       c.reset(ends, tol, step);
       c.refine();
       c.prune();
-      if (best_s) *best_s = c.best_s();
+      if constexpr (kCurves == 1) {
+        if (best_s) *best_s = c.best_s();
+      }
       candidates_.push_back({interp, tension, step, c.take_keys()});
     };
     if (opt_.force_linear) {
       add(Interpolation::linear, opt_.tension);
     } else {
-      // A fitted tension is kept only if it is cheaper (keep_fewest).
+      // A fitted tension is kept only if it is cheaper (keep_fewest). Not for three curves at
+      // once.
+      const bool fit_tension = opt_.fit_tension && kCurves == 1;
       float s = 0.0f;
-      add(Interpolation::cardinal, opt_.tension, opt_.fit_tension ? &s : nullptr);
-      if (opt_.fit_tension) add(Interpolation::cardinal, s_to_tension(s));
+      add(Interpolation::cardinal, opt_.tension, fit_tension ? &s : nullptr);
+      if (fit_tension) add(Interpolation::cardinal, s_to_tension(s));
       if (opt_.allow_linear) add(Interpolation::linear, opt_.tension);
     }
   } else {
     for (Candidate& c : candidates_) {
-      CurveFit f(y, n, c.interp, tension_to_s(c.tension), opt_.rule, scratch);
+      CurveFitT<Kind> f(y, n, c.interp, tension_to_s(c.tension), opt_.rule, scratch);
       f.resume(c.keys, tol, step, c.step, changed);
       f.refine();
       f.prune();
@@ -389,36 +522,47 @@ EncodedChannel ChannelFitter::fit(Tolerance tol, double step, const std::vector<
   keep_fewest();
   fitted_ = true;
   const Candidate& b = candidates_.front();  // the first of a tie, as before any was dropped
-  return channel_at(y, b.interp, b.tension, b.step, b.keys);
+  return result_at<Kind>(y, b.interp, b.tension, b.step, b.keys);
 }
 
-bool ChannelFitter::holds(Tolerance tol, double step, const std::vector<uint32_t>& changed, const double* y) const {
+template <class Kind>
+bool CurveFitter<Kind>::holds(Tolerance tol, double step, const std::vector<uint32_t>& changed,
+                              const typename CurveFitT<Kind>::Signals& y) const {
   if (!fitted_) return false;
   for (const Candidate& c : candidates_)
     if (c.step != step || !segments_within(c, y, tol, changed)) return false;
   return true;
 }
 
-// The segments CurveFit::resume re-measures, with measure()'s arithmetic.
-bool ChannelFitter::segments_within(const Candidate& c, const double* y, Tolerance tol,
-                                    const std::vector<uint32_t>& changed) const {
+// The segments CurveFitT::resume re-measures, with measure()'s arithmetic.
+template <class Kind>
+bool CurveFitter<Kind>::segments_within(const Candidate& c, const typename CurveFitT<Kind>::Signals& y, Tolerance tol,
+                                        const std::vector<uint32_t>& changed) const {
   const std::vector<uint32_t>& k = c.keys;
   const float s = tension_to_s(c.tension);
   return for_each_changed_segment(k, changed, [&](size_t i) {
-    const Key a{k[i], key_value(y[k[i]], c.step)}, b{k[i + 1], key_value(y[k[i + 1]], c.step)};
-    const Key before = i > 0 ? Key{k[i - 1], key_value(y[k[i - 1]], c.step)} : Key{};
-    const Key after = i + 2 < k.size() ? Key{k[i + 2], key_value(y[k[i + 2]], c.step)} : Key{};
-    const SegmentOperands ops = window_operands(i > 0 ? &before : nullptr, a, b, i + 2 < k.size() ? &after : nullptr,
-                                                c.interp, s, opt_.rule);
+    SegmentOperands ops[Kind::kCurves];
+    for (uint32_t m = 0; m < Kind::kCurves; ++m) {
+      const double* ym = y[m];
+      const Key a{k[i], key_value(ym[k[i]], c.step)}, b{k[i + 1], key_value(ym[k[i + 1]], c.step)};
+      const Key before = i > 0 ? Key{k[i - 1], key_value(ym[k[i - 1]], c.step)} : Key{};
+      const Key after = i + 2 < k.size() ? Key{k[i + 2], key_value(ym[k[i + 2]], c.step)} : Key{};
+      ops[m] = window_operands(i > 0 ? &before : nullptr, a, b, i + 2 < k.size() ? &after : nullptr, c.interp, s,
+                               opt_.rule);
+    }
     uint32_t arg = 0;
-    return worst_ratio(y, tol, ops, a.frame, b.frame, arg) <= 1.0;
+    return segment_worst<Kind>(y, tol, ops, k[i], k[i + 1], arg) <= 1.0;
   });
 }
 
-void ChannelFitter::keep_fewest() {
+template <class Kind>
+void CurveFitter<Kind>::keep_fewest() {
   size_t fewest = candidates_.front().keys.size();
   for (const Candidate& c : candidates_) fewest = std::min(fewest, c.keys.size());
   std::erase_if(candidates_, [&](const Candidate& c) { return c.keys.size() > fewest; });
 }
+
+template class CurveFitter<ChannelCurve>;
+template class CurveFitter<QuatCurve>;
 
 }  // namespace keyanim::offline

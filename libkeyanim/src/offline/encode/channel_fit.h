@@ -1,9 +1,13 @@
-// Fitting one channel: key frames, quantized key values and tension, so that the decoded curve
-// stays within a per-frame tolerance. Internal to the encoder.
+// Fitting one channel, or a quaternion node's three curves together: key frames, quantized key
+// values and tension, so that the decoded curve stays within a per-frame tolerance. Internal to
+// the encoder.
 #pragma once
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <queue>
+#include <type_traits>
 #include <vector>
 
 #include "keyanim/cardinal.h"
@@ -25,34 +29,68 @@ int64_t quantize(double y, double step) noexcept;
 // A key as the segment arithmetic sees it (window_operands takes the four around a segment).
 using Key = WindowKey;
 
+// What a fit fits.
+//  - ChannelCurve: one channel's signal (one value per frame); a frame's error is |decoded -
+//    signal| against the tolerance.
+//  - QuatCurve: a quaternion node's stored x, y, z (spec section 4.7), three curves on shared
+//    key frames; the signals are x, y, z and w of its relative rotation per frame (unit, w >=
+//    0), and a frame's error is the chord between that and the decoded rotation (keyanim/
+//    rotation.h: w rebuilt, normalized), against a tolerance given as a chord (chord_tolerance).
+struct ChannelCurve {
+  static constexpr uint32_t kCurves = 1, kSignals = 1;
+};
+struct QuatCurve {
+  static constexpr uint32_t kCurves = 3, kSignals = 4;
+};
+inline constexpr uint32_t kMaxFitCurves = 3;
+
+// A chord tolerance for QuatCurve from an angle tolerance in radians (base, per-frame factors):
+// unit quaternions an angle t apart are 2 sin(t / 4) apart, at least base_t * 2 sin(base / 4) /
+// base for every t = base_t <= base (sin x / x falls): within it, the angle is within t.
+inline Tolerance chord_tolerance(Tolerance angle) noexcept {
+  const double b = angle.base;
+  return {b > 0.0 ? 2.0 * std::sin(0.25 * b) : 0.0, angle.factor};
+}
+
 // The per-frame working arrays of a fit, reused from channel to channel (one per thread): what
 // a channel keeps between the encoder's rounds is then its keys, not arrays over its frames.
-// A CurveFit leaves the arrays clean when it is destroyed.
+// A fit leaves the arrays clean when it is destroyed.
 struct FitScratch {
   std::vector<uint32_t> prev, next;  // kNone at the ends, and for frames that are not keys
   std::vector<uint8_t> is_key;
-  std::vector<float> v;
+  std::array<std::vector<float>, kMaxFitCurves> v;  // key values per curve
   std::vector<double> seg_ratio;  // per segment, indexed by its start frame
   std::vector<uint32_t> seg_arg;
-  std::vector<double> y;          // the channel's signal, for the caller to fill
-  // Sizes every array for `frames` (keeping them clean).
-  void prepare(size_t frames);
+  std::vector<double> y;                   // a channel's signal, for the caller to fill
+  std::array<std::vector<double>, 4> q;    // a quaternion node's x, y, z, w, for the caller to fill
+  // Sizes every array for `frames` and `curves` key values per frame (keeping them clean).
+  void prepare(size_t frames, uint32_t curves = 1);
+  // The signals of a fit of `Kind` (y, or the four of q).
+  template <class Kind>
+  std::array<const double*, Kind::kSignals> signals() const noexcept {
+    if constexpr (Kind::kSignals == 1) return {y.data()};
+    else return {q[0].data(), q[1].data(), q[2].data(), q[3].data()};
+  }
 };
 
-// A channel's keys, kept within a per-frame tolerance by inserting keys at the worst frame
-// (a max-heap of segments) and pruning keys that are not needed. Between the encoder's rounds
-// only the key frames are kept; resume() rebuilds from them exactly the state the fit had, so
-// that when tolerances tighten it refines from the keys it has instead of starting over.
-// The arithmetic is the decoder's own (cardinal.h): what is checked here is what plays back.
-class CurveFit {
+// A curve's keys (a channel's, or a quaternion node's shared by its three curves), kept within a
+// per-frame tolerance by inserting keys at the worst frame (a max-heap of segments) and pruning
+// keys that are not needed. Between the encoder's rounds only the key frames are kept; resume()
+// rebuilds from them exactly the state the fit had, so that when tolerances tighten it refines
+// from the keys it has instead of starting over. The arithmetic is the decoder's own
+// (cardinal.h, rotation.h): what is checked here is what plays back.
+template <class Kind>
+class CurveFitT {
  public:
   static constexpr uint32_t kNone = UINT32_MAX;
+  static constexpr uint32_t kCurves = Kind::kCurves;
+  using Signals = std::array<const double*, Kind::kSignals>;
 
-  // y: `frames` values (kept by the caller for the fit's life).
-  CurveFit(const double* y, uint32_t frames, Interpolation interp, float s, TangentRule rule, FitScratch& scratch);
-  ~CurveFit();
-  CurveFit(const CurveFit&) = delete;
-  CurveFit& operator=(const CurveFit&) = delete;
+  // y: `frames` values per signal (kept by the caller for the fit's life).
+  CurveFitT(Signals y, uint32_t frames, Interpolation interp, float s, TangentRule rule, FitScratch& scratch);
+  ~CurveFitT();
+  CurveFitT(const CurveFitT&) = delete;
+  CurveFitT& operator=(const CurveFitT&) = delete;
 
   // Starts from `keys` (sorted; first and last frame included) with this tolerance and step.
   void reset(const std::vector<uint32_t>& keys, Tolerance tol, double step);
@@ -67,7 +105,7 @@ class CurveFit {
   // reset(), afterwards only around the keys inserted since the last prune.
   void prune();
   // Least-squares s over the non-key frames: the curve is A + s B (method.md section 3).
-  float best_s() const;
+  float best_s() const requires(Kind::kCurves == 1);
 
   size_t key_count() const { return count_; }
   // The key frames; leaves the fit empty and its scratch clean (cheaper than the destructor).
@@ -98,7 +136,7 @@ class CurveFit {
   void measure_all();
   bool try_remove(uint32_t f);
 
-  const double* y_;
+  Signals y_;
   Tolerance tol_;
   double step_ = 1.0;
   Interpolation interp_;
@@ -112,6 +150,8 @@ class CurveFit {
   bool prune_all_ = true;
   bool all_measured_ = false;  // every segment's seg_ratio and seg_arg are this fit's
 };
+using CurveFit = CurveFitT<ChannelCurve>;
+using QuatFit = CurveFitT<QuatCurve>;
 
 struct ChannelFitOptions {
   TangentRule rule = TangentRule::step_adjusted;
@@ -127,22 +167,33 @@ struct ChannelFitOptions {
 // `lo` and `hi` are the smallest and largest of y.
 std::optional<EncodedChannel> constant_channel(const double* y, uint32_t frames, double lo, double hi,
                                                Tolerance tol, double step);
+// The same for a quaternion node (QuatCurve's signals, its chord tolerance): no key where its
+// rotation is within of the reference everywhere, else one where x, y, z at the middle of their
+// extents are.
+std::optional<std::array<EncodedChannel, 3>> constant_quat(const QuatFit::Signals& y, uint32_t frames,
+                                                           const double* lo, const double* hi, Tolerance tol,
+                                                           double step);
 
 // Keys at the given frames (sorted, first and last included); values quantized with `step`.
 // Channels that are constant within `tol` still collapse to one key (or none if zero).
 EncodedChannel fit_channel_at_keys(const std::vector<double>& y, const std::vector<uint32_t>& keys, Tolerance tol,
                                    double step, const ChannelFitOptions& options, FitScratch& scratch);
+// The same for a quaternion node (scratch.q holds its signals; tol is its chord tolerance).
+std::array<EncodedChannel, 3> fit_quat_at_keys(const std::vector<uint32_t>& keys, Tolerance tol, double step,
+                                               const ChannelFitOptions& options, FitScratch& scratch);
 
-// The candidate fits of one channel in error mode (Cardinal with the given or fitted tension,
-// and linear); the first fit's winner is kept across the encoder's tightening rounds as its key
-// frames.
-class ChannelFitter {
+// The candidate fits of one channel, or of a quaternion node's three curves, in error mode
+// (Cardinal with the given or fitted tension, and linear); the first fit's winner is kept
+// across the encoder's tightening rounds as its key frames.
+template <class Kind>
+class CurveFitter {
  public:
-  explicit ChannelFitter(const ChannelFitOptions& options) : opt_(options) {}
-  // Fits (or refits, from the previous keys) scratch.y (the channel's signal) to these
+  using Result = std::conditional_t<Kind::kCurves == 1, EncodedChannel, std::array<EncodedChannel, 3>>;
+  explicit CurveFitter(const ChannelFitOptions& options) : opt_(options) {}
+  // Fits (or refits, from the previous keys) the signals in `scratch` (y, or q) to these
   // tolerances, whose values changed only at `changed` frames since the last call (null:
   // anywhere); returns the candidate with the fewest keys.
-  EncodedChannel fit(Tolerance tol, double step, const std::vector<uint32_t>* changed, FitScratch& scratch);
+  Result fit(Tolerance tol, double step, const std::vector<uint32_t>* changed, FitScratch& scratch);
   // True if fit() with these arguments would return what the last fit() returned: that was a
   // candidate (not a constant channel, which tighter tolerances at the same step cannot make
   // one), the step is the same, and every segment fit() would re-measure for the `changed`
@@ -151,7 +202,13 @@ class ChannelFitter {
   // 01_01) to nearly all (Bandai walk_normal_001) of the channels tightened in a round keep
   // their keys; encoding takes 3.7% fewer instructions on 01_01 and 5.8% on that walk
   // (callgrind, one thread), for the same bytes.
-  bool holds(Tolerance tol, double step, const std::vector<uint32_t>& changed, const double* y) const;
+  bool holds(Tolerance tol, double step, const std::vector<uint32_t>& changed,
+             const typename CurveFitT<Kind>::Signals& y) const;
+  bool holds(Tolerance tol, double step, const std::vector<uint32_t>& changed, const double* y) const
+    requires(Kind::kSignals == 1)
+  {
+    return holds(tol, step, changed, typename CurveFitT<Kind>::Signals{y});
+  }
   // How many candidates the next fit refits (keep_fewest).
   size_t candidate_count() const { return candidates_.size(); }
 
@@ -174,12 +231,15 @@ class ChannelFitter {
     std::vector<uint32_t> keys;   // key frames at the end of the last fit
   };
   // Whether every segment of c's keys that holds one of `changed` is within `tol`.
-  bool segments_within(const Candidate& c, const double* y, Tolerance tol, const std::vector<uint32_t>& changed) const;
+  bool segments_within(const Candidate& c, const typename CurveFitT<Kind>::Signals& y, Tolerance tol,
+                       const std::vector<uint32_t>& changed) const;
   ChannelFitOptions opt_;
   std::vector<Candidate> candidates_;
   bool fitted_ = false;  // the last fit() returned candidates_.front()
   bool have_extent_ = false;
-  double lo_ = 0.0, hi_ = 0.0;  // extent of the signal (it does not change between rounds)
+  double lo_[Kind::kCurves] = {}, hi_[Kind::kCurves] = {};  // extents of the signals (they do not change between rounds)
 };
+using ChannelFitter = CurveFitter<ChannelCurve>;
+using QuatFitter = CurveFitter<QuatCurve>;
 
 }  // namespace keyanim::offline
