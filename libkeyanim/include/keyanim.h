@@ -81,8 +81,10 @@ extern "C" {
 /* The loaded library's version as (major << 16) | (minor << 8) | patch, and as "0.2.0". */
 KEYANIM_C_API uint32_t keyanim_version(void);
 KEYANIM_C_API const char* keyanim_version_string(void);
-/* The .kanim format: the version this library writes (and the newest it reads), and the oldest
- * major version it reads, as (major << 16) | minor. Every major version in between is read. */
+/* The .kanim format: the version this library writes by default (rotations as quaternion
+ * curves; clips encoded with Euler rotations are written as 3.0 and 4.0, which older decoders
+ * read) and the newest it reads, and the oldest major version it reads, as (major << 16) |
+ * minor. Every major version in between is read. */
 KEYANIM_C_API uint32_t keyanim_format_version(void);
 KEYANIM_C_API uint32_t keyanim_format_oldest_version(void);
 

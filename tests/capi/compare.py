@@ -133,6 +133,12 @@ def close(a, b, tol):
     return all(abs(x - y) <= tol for x, y in zip(a, b))
 
 
+def same_rotation(a, b, tol):
+    """A quaternion and its negation are one rotation: a node stored as a quaternion (format 5)
+    takes its sign from its reference, not from the product of its Euler angles."""
+    return close(a, b, tol) or close(a, [-x for x in b], tol)
+
+
 def check(keyanim, clip_path, bvh_path, printed):
     """Problems (strings) in `printed` (parse_output's form) against the CLI and the BVH."""
     problems = []
@@ -191,13 +197,13 @@ def check(keyanim, clip_path, bvh_path, printed):
             # (local rotation), 3.5e-7 (model rotation) and 1.2e-6 of the largest coordinate
             # (model translation, Bandai's 30 levels); each bound here is 15 to 80 times that,
             # and catches any wrong axis, order, sign or parent.
-            if not close(loc[:4], q, 1e-5):
+            if not same_rotation(loc[:4], q, 1e-5):
                 problems.append(f"{where}: node {i} local rotation {loc[:4]}, from the Euler channels {q}")
             if not close(loc[4:], t, 1e-5 * max(1.0, max(abs(v) for v in t))):
                 problems.append(f"{where}: node {i} local translation {loc[4:]}, expected {t}")
             model_q.append(q if b["parent"] < 0 else quat_mul(model_q[b["parent"]], q))
             mod = s["model"][i]
-            if not close(mod[:4], model_q[i], 1e-5):
+            if not same_rotation(mod[:4], model_q[i], 1e-5):
                 problems.append(f"{where}: node {i} model rotation {mod[:4]}, composed here {model_q[i]}")
             p = world[i]["position"]
             if not close(mod[4:], p, 2e-5 * max(1.0, max(abs(v) for v in p))):

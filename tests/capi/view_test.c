@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
   CHECK(keyanim_clip_load(runtime, runtime_size, &loaded) == KEYANIM_OK);
   CHECK(keyanim_clip_runtime_profile(viewed) == 1 && keyanim_clip_runtime_profile(loaded) == 1);
   CHECK(keyanim_clip_runtime_profile(a) == 0 && keyanim_clip_runtime_profile(NULL) == 0);
-  CHECK(keyanim_clip_format_version(viewed) == (4u << 16) && keyanim_clip_format_version(a) == (3u << 16));
+  CHECK(keyanim_clip_format_version(viewed) == (5u << 16) && keyanim_clip_format_version(a) == (5u << 16));
   CHECK(same_poses(a, viewed));
   CHECK(same_poses(a, loaded));
   CHECK(keyanim_clip_total_keys(viewed) == keyanim_clip_total_keys(a));

@@ -13,9 +13,9 @@ convert)
   expect_rc 0 "$K" encode "$WALK" -o walk.kanim
   expect_rc 0 "$K" convert walk.kanim --runtime
   [ -f walk.runtime.kanim ] || die "convert --runtime did not write walk.runtime.kanim (its default name)"
-  [ "$(header walk.kanim)" = "3 0 0" ] || die "the archive file is not version 3.0, flags 0: $(header walk.kanim)"
-  [ "$(header walk.runtime.kanim)" = "4 0 1" ] || die "the runtime file is not version 4.0 with Runtime set: $(header walk.runtime.kanim)"
-  [ "$("$K" info walk.runtime.kanim --json | json 'd["profile"], d["version"]')" = "runtime 4.0" ] || die "info of the runtime file"
+  [ "$(header walk.kanim)" = "5 0 0" ] || die "the archive file is not version 5.0, flags 0: $(header walk.kanim)"
+  [ "$(header walk.runtime.kanim)" = "5 0 1" ] || die "the runtime file is not version 5.0 with Runtime set: $(header walk.runtime.kanim)"
+  [ "$("$K" info walk.runtime.kanim --json | json 'd["profile"], d["version"]')" = "runtime 5.0" ] || die "info of the runtime file"
   [ "$("$K" info walk.kanim --json | json 'd["profile"]')" = "archive" ] || die "info of the archive file"
   # Same keys and values: every command reads both alike.
   for f in 0 17.25 100.5 343; do
@@ -31,7 +31,14 @@ convert)
   expect_rc 0 "$K" convert walk.runtime.kanim --archive -o back.kanim
   expect_rc 0 "$K" decode back.kanim -o b.bvh
   cmp -s a.bvh b.bvh || die "the BVH decoded after converting back differs"
-  [ "$(header back.kanim)" = "3 0 0" ] || die "convert --archive did not write version 3.0"
+  [ "$(header back.kanim)" = "5 0 0" ] || die "convert --archive did not write version 5.0"
+  # Euler rotations: versions 3.0 and 4.0, which older decoders read.
+  expect_rc 0 "$K" encode "$WALK" -o euler.kanim --rotations euler
+  expect_rc 0 "$K" convert euler.kanim --runtime -o euler.runtime.kanim
+  [ "$(header euler.kanim)" = "3 0 0" ] || die "--rotations euler did not write version 3.0: $(header euler.kanim)"
+  [ "$(header euler.runtime.kanim)" = "4 0 1" ] || die "its runtime file is not version 4.0: $(header euler.runtime.kanim)"
+  expect_rc 1 "$K" encode "$WALK" -o bad.kanim --rotations both
+  grep -q -- '--rotations: expected quaternion or euler' .stderr || die "a bad --rotations: $(cat .stderr)"
   ;;
 encode)
   expect_rc 0 "$K" encode "$HOP" -o hop.kanim

@@ -114,6 +114,7 @@ TEST_SUITE("encode") {
   TEST_CASE("constant and zero channels cost one key and none") {
     const Motion m = arm_motion(300);
     EncodeSettings s;
+    s.rotations = Rotations::euler;  // channel 8 is a rotation channel of its own
     EncodeResult r;
     round_trip(m, s, r);
     CHECK(r.clip.channels[1].frames.size() == 1);  // constant height
@@ -121,9 +122,33 @@ TEST_SUITE("encode") {
     CHECK(r.clip.channels[8].frames.empty());
   }
 
+  TEST_CASE("rotations as quaternion curves: a still joint costs no key, a turning root keeps its Euler channels") {
+    Motion m = arm_motion(1200);  // 10 s: the root turns through 400 degrees
+    for (uint32_t f = 0; f < m.frame_count; ++f) m.frame(f)[6] = m.frame(f)[7] = m.frame(f)[8] = 0.0;  // the arm still
+    EncodeSettings s;
+    EncodeResult r;
+    const Motion back = round_trip(m, s, r);
+    // The root turns through 400 degrees (channel 5): no reference is within 145 degrees of
+    // all its rotations.
+    REQUIRE(r.clip.quat_nodes.size() == 1);
+    CHECK(r.clip.quat_nodes[0].node == 1);
+    for (int16_t x : r.clip.quat_nodes[0].reference) CHECK(x == 0);  // the identity
+    for (uint32_t c = 6; c < 9; ++c) CHECK(r.clip.channels[c].frames.empty());
+    CHECK(r.clip.channels[3].frames.size() > 2);  // the root's Euler channels
+    CHECK(measure_error(m, back, r.shell_units).max_error <= r.tolerance_units);
+    // Moving, the arm's three curves share their key frames.
+    const Motion moving = arm_motion(1200);
+    round_trip(moving, s, r);
+    REQUIRE(r.clip.quat_nodes.size() == 1);
+    CHECK(r.clip.channels[6].frames.size() > 2);
+    CHECK(r.clip.channels[7].frames == r.clip.channels[6].frames);
+    CHECK(r.clip.channels[8].frames == r.clip.channels[6].frames);
+  }
+
   TEST_CASE("the wrapped channel is stored unwrapped and decodes to the same rotation") {
     const Motion m = arm_motion(600);
     EncodeSettings s;
+    s.rotations = Rotations::euler;  // (the default keeps this root's Euler channels too)
     s.tolerance = 0.01;
     s.tolerance_in_percent = false;
     EncodeResult r;

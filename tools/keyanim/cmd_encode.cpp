@@ -23,7 +23,8 @@ namespace keyanim::cli {
 
 const char* const kEncodeHelp =
     "usage: keyanim encode IN.bvh|DIR [-o OUT.kanim|OUTDIR] [--to kanim] [--error E|E%] [--shell D|D%]\n"
-    "                      [--keys MODE] [--tension T|fit] [--level N] [--runtime] [-j N] [--json] [-f]\n"
+    "                      [--keys MODE] [--tension T|fit] [--rotations quaternion|euler] [--level N]\n"
+    "                      [--runtime] [-j N] [--json] [-f]\n"
     "  or:  keyanim encode --manifest LIST -o OUTDIR|LIB.kbank [--bank] [--shard I/N] [--skip-existing]\n"
     "                      [--report R.jsonl] [--error E|E%] [--shell D|D%] [--keys MODE] [-j N] [-f]\n"
     "Stores only keyframes; every frame decodes within the tolerance (error mode): every joint,\n"

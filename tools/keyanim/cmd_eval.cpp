@@ -29,8 +29,8 @@ namespace keyanim::cli {
 
 const char* const kEvalHelp =
     "usage: keyanim eval IN.bvh|DIR... [--error E1,E2,...] [--shell D|D%] [--keys MODE[+MODE...]]\n"
-    "                    [--tension T|fit] [--level N] [-j N] [--json] [--svg RD.svg] [--report R.jsonl]\n"
-    "                    [--acl TABLE.tsv]\n"
+    "                    [--tension T|fit] [--rotations quaternion|euler] [--level N] [-j N] [--json]\n"
+    "                    [--svg RD.svg] [--report R.jsonl] [--acl TABLE.tsv]\n"
     "Encodes each file at each tolerance and measures what a decoder gets back: keys, bytes,\n"
     "ratios against raw float32 (frames x channels x 4), the BVH text and the BVH text compressed\n"
     "by zstd -19, the max and RMS world-space error of joints, End Sites and shell points with\n"

@@ -22,7 +22,8 @@ namespace keyanim::cli {
 
 const char* const kPackHelp =
     "usage: keyanim pack IN... -o LIB.kbank [--runtime] [--dictionary auto|on|off] [--error E|E%]\n"
-    "                    [--shell D|D%] [--keys MODE] [--tension T|fit] [--level N] [-j N] [--json] [-f]\n"
+    "                    [--shell D|D%] [--keys MODE] [--tension T|fit] [--rotations quaternion|euler]\n"
+    "                    [--level N] [-j N] [--json] [-f]\n"
     "  or:  keyanim pack --manifest LIST [IN...] -o LIB.kbank [--runtime] [...]\n"
     "Puts many clips into one bank (format 4.1): each distinct skeleton is stored once, a clip is\n"
     "found by name without reading the others, and each clip has its own checksum. IN is a .bvh\n"

@@ -15,10 +15,11 @@ namespace keyanim::cli {
 const char* const kPlotHelp =
     "usage: keyanim plot IN.bvh --channel JOINT:CHANNEL [-o CURVE.svg] [--to svg] [--frames A:B]\n"
     "                    [--error E|E%] [--shell D|D%] [--keys MODE] [--tension T|fit]\n"
-    "                    [--level N] [-f]\n"
+    "                    [--rotations euler|quaternion] [--level N] [-f]\n"
     "Encodes IN with the given settings and draws one channel over the frames: the original curve\n"
     "(rotations unwrapped), the decoder's reconstruction and one dot per key. Values in degrees for\n"
-    "rotations, in file length units for positions.\n"
+    "rotations, in file length units for positions. Rotations are encoded as Euler channels here\n"
+    "(--rotations euler, this command's default), so that a rotation channel's keys are its own.\n"
     "  --channel JOINT:CHANNEL  required; CHANNEL is Xposition, Yposition, Zposition, Xrotation,\n"
     "                        Yrotation or Zrotation (e.g. RightArm:Zrotation)\n"
     "  --frames A:B          draw frames A..B only, inclusive (default: all; A: or :B leave one\n"
@@ -47,7 +48,9 @@ int cmd_plot(const Argv& argv, Globals& g) {
   if (args.positional().size() != 1) fail(kUsage, "plot takes one BVH file");
   const auto spec = args.get("--channel");
   if (!spec) fail(kUsage, "plot needs --channel JOINT:CHANNEL");
-  const offline::EncodeSettings settings = encode_settings(args);
+  // A channel's own keys are drawn: Euler rotations unless asked otherwise (a quaternion node's
+  // keys hold its x, y, z; its channel is then drawn from them, with a dot per shared key).
+  const offline::EncodeSettings settings = encode_settings(args, true, true, offline::Rotations::euler);
   const std::string in = args.positional()[0];
   const bool to_svg = stated_format(args, "svg");
 

@@ -25,7 +25,8 @@ namespace keyanim::cli {
 const char* const kRenderHelp =
     "usage: keyanim render IN.bvh|IN.kanim [--frame N] [--against OTHER] [-o FRAME.svg] [--to svg]\n"
     "                      [--position-channels replace|add] [--up y|z|auto] [--error E|E%]\n"
-    "                      [--shell D|D%] [--keys MODE] [--tension T|fit] [--level N] [-f]\n"
+    "                      [--shell D|D%] [--keys MODE] [--tension T|fit] [--rotations quaternion|euler]\n"
+    "                      [--level N] [-f]\n"
     "Draws one frame as a stick figure, front view (x-y) and side view (z-y) at one scale, in\n"
     "file length units (x-z and y-z for a z-up file). Two poses are overlaid and the joint\n"
     "farthest apart is labelled:\n"

@@ -137,6 +137,10 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   std::vector<uint32_t> key_frames(key_count);
   std::vector<float> key_values(key_count);
   clip.channel_keys(channel, key_frames, key_values);
+  // A quaternion node's keys hold its x, y, z: the channel's dots are its angle at them.
+  const bool stored_quat = clip.channel(channel).stored != StoredAs::value;
+  if (stored_quat)
+    for (uint32_t k = 0; k < key_count; ++k) key_values[k] = static_cast<float>(value_at(key_frames[k]));
   // An angle and the same angle +-360 are one pose; show both curves on one branch.
   double shift = 0.0;
   if (rotation) {
@@ -153,6 +157,7 @@ bool plot_channel(const offline::Motion& motion, const offline::EncodeSettings& 
   for (uint32_t f = first; f <= last; ++f)
     for (uint32_t j = 0; j < (f < last ? steps : 1u); ++j) recon_pos.push_back(f + double(j) / steps);
   for (const double x : recon_pos) recon.push_back(value_at(x) + shift);
+  if (stored_quat && rotation) offline::unwrap_degrees(recon);  // angles of a rotation: each in (-180, 180]
 
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (uint32_t f = first; f <= last; ++f) lo = std::min(lo, original[f]), hi = std::max(hi, original[f]);

@@ -25,6 +25,13 @@ std::string encoder_options_help(bool with_error) {
       "                        the error reached (and warn when it exceeds a given --error).\n"
       "  --tension T|fit       Cardinal tension in [-1, 1] (0 = Catmull-Rom, default), or 'fit':\n"
       "                        least squares per channel, kept where it saves keys.\n"
+      "  --rotations FORM      quaternion (default): each joint with three rotation channels whose\n"
+      "                        rotation stays within 145 degrees of one reference is stored as the\n"
+      "                        x, y, z curves of its rotation on key frames shared by the three\n"
+      "                        (format 5: fewer bytes, poses without trigonometry); euler: every\n"
+      "                        rotation as its Euler channels (format 3, which decoders of\n"
+      "                        versions 3 and 4 read). Decoded BVH channels are Euler angles either\n"
+      "                        way.\n"
       "  --level N             zstd level of every section, 1..22 (19: what keyanim 0.2 wrote).\n"
       "                        Default: each section at the zstd parameters measured for it,\n"
       "                        within 0.3% of -19's bytes for a quarter of its instructions.\n";
@@ -61,7 +68,7 @@ void check_settings_for(const offline::EncodeSettings& s, const offline::Motion&
     or_fail(kUsage, path + ": --keys manual: ", [&] { return offline::manual_keys(s.manual_frames, motion.frame_count); });
 }
 
-offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool read_keys) {
+offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool read_keys, offline::Rotations rotations) {
   offline::EncodeSettings s;
   if (auto e = args.get("--error"); e && read_error) parse_tolerance(*e, s);
   if (auto d = args.get("--shell")) parse_shell(*d, s);
@@ -72,6 +79,12 @@ offline::EncodeSettings encode_settings(const Args& args, bool read_error, bool 
     } else {
       s.tension = static_cast<float>(parse_double("--tension", *t));
     }
+  }
+  s.rotations = rotations;
+  if (auto r = args.get("--rotations")) {
+    if (*r == "quaternion") s.rotations = offline::Rotations::quaternion;
+    else if (*r == "euler") s.rotations = offline::Rotations::euler;
+    else fail(kUsage, "--rotations: expected quaternion or euler, got '" + *r + "'");
   }
   if (auto l = args.get("--level")) s.zstd_level = static_cast<int>(parse_uint("--level", *l));
   or_fail(kUsage, "", [&] { s.validate(); });

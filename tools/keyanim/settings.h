@@ -1,5 +1,5 @@
-// Encoder options shared by `encode`, `eval` and `plot`: --error, --shell, --keys, --tension,
-// --level.
+// Encoder options shared by `encode`, `eval`, `pack`, `render` and `plot`: --error, --shell,
+// --keys, --tension, --rotations, --level.
 #pragma once
 #include <string>
 
@@ -10,12 +10,14 @@
 namespace keyanim::cli {
 
 // Options that take a value, to declare in Args.
-inline const char* const kEncodeValuedOptions[] = {"--error", "--shell", "--keys", "--tension", "--level"};
+inline const char* const kEncodeValuedOptions[] = {"--error", "--shell", "--keys", "--tension", "--rotations", "--level"};
 
 // Reads the options (with their documented defaults) and validates them: usage error if wrong.
 // read_error = false leaves --error to the caller (eval takes a list), read_keys = false
 // --keys (eval takes several modes).
-offline::EncodeSettings encode_settings(const Args& args, bool read_error = true, bool read_keys = true);
+// `rotations`: the default of --rotations (plot's is euler: it draws a channel's own keys).
+offline::EncodeSettings encode_settings(const Args& args, bool read_error = true, bool read_keys = true,
+                                        offline::Rotations rotations = offline::Rotations::quaternion);
 // "0.05%" or "0.1" -> settings.tolerance / tolerance_in_percent; usage error if malformed.
 void parse_tolerance(const std::string& text, offline::EncodeSettings& s, const std::string& option = "--error");
 // "2%" or "3" or "0" -> settings.shell / shell_in_percent; usage error if malformed or negative.

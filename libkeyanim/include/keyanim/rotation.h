@@ -6,6 +6,7 @@
 // the encoder in binary64 (its error guarantee), the runtime in binary32 lanes (its poses),
 // through the same template.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -14,11 +15,30 @@
 namespace keyanim {
 
 // A node stored as a quaternion (QUAT): its rotation channels c, c + 1, c + 2 (its first three,
-// consecutive in its channel list) hold x, y, z of the rotation relative to `reference`.
+// consecutive in its channel list) hold x, y, z of the rotation relative to its reference, a
+// unit quaternion given by its x, y, z in units of 2^-15 (kReferenceUnit), w = sqrt(1 - x^2 -
+// y^2 - z^2) >= 0: the identity (0, 0, 0) for most joints, whose rotation stays near the rest
+// pose's, so that the references of a short clip cost a few bytes.
 struct QuatNode {
   uint32_t node = 0;
-  float reference[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // x, y, z, w: a unit quaternion in binary32
+  int16_t reference[3] = {0, 0, 0};  // x^2 + y^2 + z^2 <= 2^30
 };
+inline constexpr double kReferenceUnit = 1.0 / 32768.0;
+
+// The reference of `n` as a unit quaternion (x, y, z, w) in binary64: x, y, z exactly, w =
+// sqrt(1 - (x^2 + y^2 + z^2)) (the sum exact in binary64: integers below 2^31 times 2^-30).
+inline void reference_of(const QuatNode& n, double (&q)[4]) noexcept {
+  const double x = n.reference[0], y = n.reference[1], z = n.reference[2];
+  const double sum = (x * x + y * y) + z * z;
+  q[0] = x * kReferenceUnit, q[1] = y * kReferenceUnit, q[2] = z * kReferenceUnit;
+  q[3] = std::sqrt(std::max(0.0, 1.0 - sum * (kReferenceUnit * kReferenceUnit)));
+}
+// The same rounded to binary32 (what a runtime image holds).
+inline void reference_of(const QuatNode& n, float (&q)[4]) noexcept {
+  double d[4];
+  reference_of(n, d);
+  for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(d[k]);
+}
 
 // Whether `joint` can be stored as a quaternion (spec 4.7): exactly three rotation channels,
 // consecutive in its channel list, about three different axes. `first` gets the index in its
@@ -55,9 +75,10 @@ inline void stored_rotation(const T (&ref)[4], T x, T y, T z, T (&q)[4], Sqrt sq
   q[0] = qx * inv, q[1] = qy * inv, q[2] = qz * inv, q[3] = qw * inv;
 }
 
-// The binary64 form (encoder, converters): the reference widened exactly.
-inline void stored_rotation(const float (&reference)[4], double x, double y, double z, double (&q)[4]) noexcept {
-  const double ref[4] = {reference[0], reference[1], reference[2], reference[3]};
+// The binary64 form (encoder, converters).
+inline void stored_rotation(const QuatNode& n, double x, double y, double z, double (&q)[4]) noexcept {
+  double ref[4];
+  reference_of(n, ref);
   stored_rotation<double>(ref, x, y, z, q, [](double v) { return std::sqrt(v); },
                           [](double v) { return v > 0.0 ? v : 0.0; });
 }

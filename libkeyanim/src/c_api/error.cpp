@@ -96,7 +96,7 @@ uint32_t keyanim_version(void) {
 }
 const char* keyanim_version_string(void) { return KEYANIM_VERSION_STRING; }
 uint32_t keyanim_format_version(void) {
-  return (uint32_t{keyanim::kFormatVersionMajor} << 16) | keyanim::kFormatVersionMinor;
+  return (uint32_t{keyanim::kQuatFormatVersionMajor} << 16) | keyanim::kQuatFormatVersionMinor;
 }
 uint32_t keyanim_format_oldest_version(void) { return uint32_t{keyanim::kOldestFormatVersionMajor} << 16; }
 

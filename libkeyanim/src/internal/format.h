@@ -55,9 +55,7 @@ inline constexpr int kCriticalSlotsV5[6] = {0, 1, kQuatSlot, 2, 3, 4};
 inline constexpr uint32_t kMemberTagsV5[5] = {kTagClip, kTagQuat, kTagChan, kTagKtim, kTagKval};
 inline constexpr int kMemberSlotsV5[5] = {0, kQuatSlot, 2, 3, 4};
 inline constexpr size_t kQuatHeaderBytes = 4;  // Quat_Count
-inline constexpr size_t kQuatEntryBytes = 20;  // Node u32, Reference f32[4]
-// A reference is a unit quaternion rounded to binary32: |x^2 + y^2 + z^2 + w^2 - 1| <= 2^-10.
-inline constexpr double kQuatNormSlack = 1.0 / 1024.0;
+inline constexpr size_t kQuatEntryBytes = 10;  // Node u32, Reference i16[3]
 
 inline constexpr size_t kClipSize = 32;
 inline constexpr size_t kNodeFixedBytes = 34;     // name length, parent, offset, flags, count

@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <vector>
 
@@ -39,11 +40,24 @@ inline std::vector<Stored> stored_kinds(const Skeleton& s, std::span<const QuatN
   return out;
 }
 
-// Whether a reference is a unit quaternion in binary32 (section 4.7): finite, its squared norm
-// within kQuatNormSlack of 1.
-inline bool valid_reference(const float (&r)[4]) noexcept {
-  const double n = double(r[0]) * r[0] + double(r[1]) * r[1] + double(r[2]) * r[2] + double(r[3]) * r[3];
-  return std::isfinite(n) && std::fabs(n - 1.0) <= kQuatNormSlack;
+// Whether a reference's x, y, z are those of a unit quaternion (section 4.7): x^2 + y^2 + z^2 <=
+// 2^30 (in units of 2^-15).
+inline bool valid_reference(const int16_t (&r)[3]) noexcept {
+  const int64_t x = r[0], y = r[1], z = r[2];
+  return x * x + y * y + z * z <= (int64_t(1) << 30);
+}
+// The binary32 reference an image holds for `n` (reference_of), and whether four floats are
+// that of some valid reference (its x, y, z back in `n`).
+inline bool reference_from_floats(const float (&q)[4], QuatNode& n) noexcept {
+  for (int k = 0; k < 3; ++k) {
+    const double v = double(q[k]) / kReferenceUnit;
+    if (!(v >= -32768.0 && v <= 32767.0) || v != std::floor(v)) return false;
+    n.reference[k] = static_cast<int16_t>(v);
+  }
+  if (!valid_reference(n.reference)) return false;
+  float back[4];
+  reference_of(n, back);
+  return std::memcmp(back, q, sizeof back) == 0;
 }
 
 }  // namespace keyanim::internal

@@ -68,9 +68,16 @@ std::vector<uint8_t> train_dictionary(const Samples& samples, size_t capacity) {
   return dict;
 }
 
-std::vector<uint8_t> member_bytes(const std::vector<Section>& sections, bool runtime) {
+// A member's version: 5.0 for a clip with quaternion nodes (QUAT, section 4.7; IMAG's of version
+// 5), else the bank's 4.1.
+bool quat_member(const std::vector<Section>& sections) {
+  return std::any_of(sections.begin(), sections.end(), [](const Section& s) { return s.tag == internal::kTagQuat; });
+}
+
+std::vector<uint8_t> member_bytes(const std::vector<Section>& sections, bool runtime, bool quat) {
   const uint32_t flags = internal::kHeaderMember | (runtime ? internal::kHeaderRuntime : 0u);
-  std::vector<uint8_t> out = assemble(sections, kRuntimeFormatVersionMajor, internal::kBankVersionMinor, flags,
+  std::vector<uint8_t> out = assemble(sections, quat ? kQuatFormatVersionMajor : kRuntimeFormatVersionMajor,
+                                      quat ? kQuatFormatVersionMinor : internal::kBankVersionMinor, flags,
                                       runtime ? internal::kRuntimeChecksumSize : internal::kChecksumSize);
   if (runtime) put_le<uint64_t>(out, internal::xxh64_of(out.data(), out.size()));
   else put_le<uint32_t>(out, crc32_of(out.data(), out.size()));
@@ -80,7 +87,11 @@ std::vector<uint8_t> member_bytes(const std::vector<Section>& sections, bool run
 std::vector<std::vector<uint8_t>> archive_members(const std::vector<std::vector<RawSection>>& raw,
                                                   std::span<const uint8_t> dictionary) {
   std::vector<std::vector<uint8_t>> out;
-  for (const auto& m : raw) out.push_back(member_bytes(compress_sections(m, dictionary), false));
+  for (const auto& m : raw) {
+    std::vector<Section> sections = compress_sections(m, dictionary);
+    const bool quat = quat_member(sections);
+    out.push_back(member_bytes(sections, false, quat));
+  }
   return out;
 }
 
@@ -92,6 +103,7 @@ struct Parts {
   std::vector<uint32_t> skeleton_of;  // per clip
   std::vector<std::vector<uint8_t>> members;
   std::vector<uint8_t> dictionary;
+  bool quat = false;  // a member of version 5: the bank is version 5.0 (section 10.2)
 };
 
 // Header, tables, names, dictionary, skeletons, checksum, members, each where 10.1 puts it.
@@ -114,8 +126,8 @@ std::vector<uint8_t> assemble_bank(const std::vector<BankInput>& clips, const Pa
 
   std::vector<uint8_t> out(internal::kSignature, internal::kSignature + internal::kSignatureSize);
   out.reserve(end);
-  put_le<uint16_t>(out, kRuntimeFormatVersionMajor);
-  put_le<uint16_t>(out, internal::kBankVersionMinor);
+  put_le<uint16_t>(out, p.quat ? kQuatFormatVersionMajor : kRuntimeFormatVersionMajor);
+  put_le<uint16_t>(out, p.quat ? kQuatFormatVersionMinor : internal::kBankVersionMinor);
   put_le<uint32_t>(out, internal::kHeaderBank | (runtime ? internal::kHeaderRuntime : 0u));
   put_le<uint32_t>(out, static_cast<uint32_t>(clips.size()));
   put_le<uint32_t>(out, static_cast<uint32_t>(p.skeletons.size()));
@@ -185,11 +197,12 @@ WrittenBank write_bank(const std::vector<BankInput>& clips, const BankOptions& o
       skeletons.push_back(std::move(skel));
     }
     p.skeleton_of.push_back(index);
+    p.quat |= !c.clip.quat_nodes.empty();
     try {
       if (options.runtime) {
         std::vector<Section> s = runtime_sections(to_clip(c.clip));
         drop_skel(s);
-        p.members.push_back(member_bytes(s, true));
+        p.members.push_back(member_bytes(s, true, !c.clip.quat_nodes.empty()));
       } else {
         raw.push_back(archive_raw_sections(c.clip, options.zstd_level));
         drop_skel(raw.back());

@@ -221,7 +221,7 @@ std::string quat_problem(const EncodedClip& clip) {
     if (n.node >= joints.size()) return where + "no such node";
     if (i > 0 && n.node <= clip.quat_nodes[i - 1].node) return where + "nodes not strictly increasing";
     if (!quaternion_capable(joints[n.node])) return where + "its node lacks three consecutive rotation channels about three axes";
-    if (!internal::valid_reference(n.reference)) return where + "reference not a unit quaternion in binary32";
+    if (!internal::valid_reference(n.reference)) return where + "reference's x^2 + y^2 + z^2 above 1";
     const uint32_t c = internal::quat_column(s, n.node);
     const EncodedChannel& x = clip.channels[c];
     for (uint32_t k = 1; k < 3; ++k) {
@@ -295,7 +295,7 @@ std::vector<uint8_t> quat_section(const std::vector<QuatNode>& nodes) {
   std::memcpy(s.data(), &count, sizeof count);
   for (const QuatNode& n : nodes) {
     put_le<uint32_t>(s, n.node);
-    for (float r : n.reference) put_le<float>(s, r);
+    for (int16_t r : n.reference) put_le<int16_t>(s, r);
   }
   return s;
 }

@@ -84,7 +84,7 @@ void FrameDecoder::start(const Clip& clip, const ResampleOptions& options) {
 void FrameDecoder::quat_angles(QuatAngles& q, std::span<double> row) {
   const float* xyz = pose_.data() + q.column;
   double rotation[4], deg[3];
-  stored_rotation(q.node.reference, xyz[0], xyz[1], xyz[2], rotation);
+  stored_rotation(q.node, xyz[0], xyz[1], xyz[2], rotation);
   euler_from_quaternion(rotation, q.axes, deg);
   if (q.have_previous) nearest_euler(q.previous, deg);
   for (uint32_t k = 0; k < 3; ++k) q.previous[k] = deg[k];

@@ -169,7 +169,10 @@ QuatForms::QuatForms(const Skeleton& skeleton, const std::vector<QuatNode>& node
     uint32_t first = 0;
     quaternion_capable(skeleton.joints[n.node], &first);
     of_node[n.node] = int32_t(i);
-    reference.push_back({n.reference[0], n.reference[1], n.reference[2], n.reference[3]});
+    double ref[4];
+    reference_of(n, ref);
+    reference.push_back({ref[0], ref[1], ref[2], ref[3]});
+    node.push_back(n.node);
     column.push_back(skeleton.joints[n.node].first_channel + first);
   }
 }
@@ -307,11 +310,11 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const do
 }
 
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
-                std::vector<Mat3>& rotations, PositionReading reading) {
+                std::vector<Mat3>& rotations, PositionReading reading, const QuatForms* quats) {
   const size_t n = skeleton.joints.size();
   positions.resize(n);
   rotations.resize(n);
-  pose_frame(skeleton, OneRow{frame_row}, positions.data(), rotations.data(), nullptr, reading);
+  pose_frame(skeleton, OneRow{frame_row, quats}, positions.data(), rotations.data(), nullptr, reading);
 }
 
 std::vector<Vec3> world_positions_all(const Motion& motion, PositionReading reading) {

@@ -8,6 +8,7 @@
 #include <new>
 #include <vector>
 
+#include "internal/quat_layout.h"
 #include "internal/simd.h"
 #include "runtime/clip_access.h"
 #include "runtime/cursor_state.h"
@@ -93,10 +94,13 @@ bool quat_of_channel(const Image& img, uint32_t c, uint32_t& quat, uint32_t& com
 // Quaternion node i's Euler angles (degrees, its rotation channels' order) from its stored x,
 // y, z: Appendix B, in binary64.
 void quat_euler(const Image& img, uint32_t i, const float (&xyz)[3], float (&out)[3]) noexcept {
+  QuatNode n;
+  n.node = img.quat_node[i];
   float ref[4];
   for (uint32_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
+  internal::reference_from_floats(ref, n);  // the image's were checked so
   double q[4], deg[3];
-  stored_rotation(ref, xyz[0], xyz[1], xyz[2], q);
+  stored_rotation(n, xyz[0], xyz[1], xyz[2], q);
   const Joint& j = img.rig->skeleton.joints[img.quat_node[i]];
   const uint32_t first = img.quat_column[i] - j.first_channel;
   const uint8_t axes[3] = {static_cast<uint8_t>(channel_axis(j.channels[first])),
@@ -144,7 +148,9 @@ QuatNode Clip::quat_node(uint32_t i) const noexcept {
   QuatNode n;
   if (i >= img.quat_node.size()) return n;
   n.node = img.quat_node[i];
-  for (uint32_t k = 0; k < 4; ++k) n.reference[k] = img.quat_reference[k * img.quat_lanes + i];
+  float ref[4];
+  for (uint32_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
+  internal::reference_from_floats(ref, n);
   return n;
 }
 

@@ -286,7 +286,9 @@ void add_quat_arrays(const ClipSource& src, Arrays& a) {
     const QuatNode& n = src.quat_nodes[i];
     a.quat_node.push_back(n.node);
     a.quat_column.push_back(quat_column(src.skeleton, n.node));
-    for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = n.reference[k];
+    float ref[4];
+    reference_of(n, ref);
+    for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = ref[k];
   }
   const std::vector<Stored> kinds = stored_kinds(src.skeleton, src.quat_nodes);
   a.block_tracks = 0;

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include "internal/quat_layout.h"
 #include "runtime/image.h"
 
 namespace keyanim::internal {
@@ -50,7 +51,9 @@ ClipSource image_keys(const Image& img) {
   src.quat_nodes.resize(img.quat_node.size());
   for (size_t i = 0; i < src.quat_nodes.size(); ++i) {
     src.quat_nodes[i].node = img.quat_node[i];
-    for (size_t k = 0; k < 4; ++k) src.quat_nodes[i].reference[k] = img.quat_reference[k * img.quat_lanes + i];
+    float ref[4];
+    for (size_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
+    reference_from_floats(ref, src.quat_nodes[i]);  // checked when the image was
   }
   src.channels.resize(img.interp.size());
   src.frames.reserve(static_cast<size_t>(img.total_keys));

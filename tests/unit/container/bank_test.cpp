@@ -297,7 +297,7 @@ TEST_CASE("the rules of section 10, broken one at a time") {
     }
   }
   SUBCASE("header") {
-    CHECK(broken([](auto& b) { put_le(b, 8, 2, 5); }) == Status::unsupported_version);
+    CHECK(broken([](auto& b) { put_le(b, 8, 2, 6); }) == Status::unsupported_version);
     CHECK(broken([](auto& b) { b[12] |= 0x08; }) == Status::reserved_bits_set);
     CHECK(broken([](auto& b) { b[12] |= 0x02; }) == Status::corrupt);  // Member set in a bank
   }

@@ -314,6 +314,100 @@ inline EncodedClip random_clip(uint64_t seed, uint32_t frames, uint32_t joints) 
   return c;
 }
 
+// Version 5 (spec section 4.7): quaternion nodes beside Euler channels. A root keeping its
+// Euler channels; a chest stored as a quaternion about the identity (dense keys across block
+// boundaries, a tension, different steps for x, y, z); an arm about another reference, linear,
+// whose rotation channels come before a position channel; a hand in X Y Z order with one key; a
+// still neck with none; a head whose rotations are not consecutive (Euler, as it must be); a
+// node with two rotation channels (Euler); End Sites. Integer-valued curves, so that the file
+// does not depend on any libm.
+inline EncodedClip vector_quat() {
+  EncodedClip c;
+  c.skeleton.joints = {
+      node("Hips", -1, 0, 90, 0, {CT::x_position, CT::y_position, CT::z_position, CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("Chest", 0, 0, 12, 0, {CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("Arm", 1, 8, 4, 0, {CT::y_rotation, CT::z_rotation, CT::x_rotation, CT::x_position}),
+      node("Hand", 2, 10, 0, 0, {CT::x_rotation, CT::y_rotation, CT::z_rotation}),
+      node("", 3, 3, 0, 0, {}, true),
+      node("Neck", 1, 0, 6, 0, {CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("Head", 5, 0, 4, 0, {CT::z_rotation, CT::x_position, CT::x_rotation, CT::y_rotation}),
+      node("Jaw", 6, 0, 1, 1, {CT::x_rotation, CT::z_rotation}),
+      node("", 7, 0, 0, 2, {}, true),
+  };
+  c.frame_count = 200;
+  c.frame_time = 1.0 / 60.0;
+  c.tangent_rule = TangentRule::step_adjusted;
+  c.skeleton.assign_channel_columns();
+  // A smooth integer curve through frames `f` (seeded), small enough that x^2 + y^2 + z^2 < 1.
+  auto curve = [](const std::vector<uint32_t>& f, int64_t seed, int64_t scale) {
+    std::vector<int64_t> q;
+    for (uint32_t x : f) {
+      const int64_t t = int64_t(x) - 100;
+      q.push_back(((t * t * (seed % 5 + 1)) / 7 - t * (seed * 13 % 17) - 3000 * (seed % 3)) * scale / 100);
+    }
+    return q;
+  };
+  std::vector<uint32_t> dense, sparse = {0, 37, 90, 150, 199};
+  for (uint32_t f = 0; f < 200; f += f % 5 == 0 ? 2 : 3) dense.push_back(f);
+  if (dense.back() != 199) dense.push_back(199);
+  // Hips: positions and Euler angles, as version 3 stores them.
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, dense, curve(dense, 1, 100)));
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, {0}, {9000}));
+  c.channels.push_back(chan(kLin, 0.0f, 0.01, {0, 199}, {0, 5000}));
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.0f, 0.02, sparse, curve(sparse, 2 + k, 100)));
+  // Chest: x, y, z about the identity (steps 2^-14, 2^-13.75, 2^-14.25).
+  const double steps[3] = {1.0 / 16384.0, 1.189207115002721 / 16384.0, 0.8408964152537145 / 16384.0};
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.25f, steps[k], dense, curve(dense, 4 + k, 15)));
+  // Arm: y, z, x rotations then a position; x, y, z about a turned reference, linear.
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kLin, 0.0f, 1.0 / 8192.0, sparse, curve(sparse, 7 + k, 4)));
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, sparse, curve(sparse, 10, 10)));
+  // Hand: one key.
+  const int64_t one[3] = {-1200, 400, 2500};
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.0f, 1.0 / 8192.0, {120}, {one[k]}));
+  // Neck: no key (its reference's rotation throughout).
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.0f, 1.0 / 8192.0, {}, {}));
+  // Head (Euler: a position channel between its rotations) and Jaw (two rotation channels).
+  for (int k = 0; k < 4; ++k) c.channels.push_back(chan(kCard, 0.0f, 0.05, sparse, curve(sparse, 11 + k, 50)));
+  for (int k = 0; k < 2; ++k) c.channels.push_back(chan(kCard, -0.5f, 0.05, dense, curve(dense, 15 + k, 20)));
+  c.quat_nodes = {{1, {0, 0, 0}}, {2, {-9000, 12000, 3000}}, {3, {0, 0, 16384}}, {5, {100, -200, 300}}};
+  return c;
+}
+
+// Version 5 over many blocks: quaternion nodes whose three curves are block curves (keys on
+// both sides of block boundaries, a block full of keys, a 3000-frame gap, curves starting and
+// ending inside blocks) and one whose are list curves (fewer keys than a quarter of the
+// blocks), beside an Euler channel.
+inline EncodedClip vector_quat_blocks() {
+  EncodedClip c;
+  c.skeleton.joints = {
+      node("Root", -1, 0, 0, 0, {CT::y_position, CT::z_rotation, CT::x_rotation, CT::y_rotation}),
+      node("A", 0, 0, 5, 0, {CT::z_rotation, CT::y_rotation, CT::x_rotation}),
+      node("B", 1, 0, 5, 0, {CT::x_rotation, CT::z_rotation, CT::y_rotation}),
+      node("", 2, 0, 5, 0, {}, true),
+  };
+  c.frame_count = 5000;
+  c.frame_time = 1.0 / 120.0;
+  c.tangent_rule = TangentRule::step_adjusted;
+  c.skeleton.assign_channel_columns();
+  std::vector<uint32_t> edges = {0, 1, 62, 63, 64, 65, 127, 128, 191, 192, 255, 256, 3300, 3301, 4999};
+  for (uint32_t f = 3968; f < 4032; ++f) edges.push_back(f);  // block 62 full: 64 keys
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<uint32_t> inner = {70, 75, 200, 4500};
+  std::vector<uint32_t> sparse = {0, 2500, 4999};
+  auto values = [](const std::vector<uint32_t>& f, int64_t seed) {
+    std::vector<int64_t> q;
+    for (size_t i = 0; i < f.size(); ++i) q.push_back((int64_t(i) * (37 + seed) + seed * 11) % 401 - 200);
+    return q;
+  };
+  c.channels.push_back(chan(kCard, 0.0f, 0.01, edges, values(edges, 0)));
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.0f, 0.25, inner, values(inner, 1 + k)));  // Euler
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.0f, 1.0 / 1024.0, edges, values(edges, 4 + k)));
+  for (int k = 0; k < 3; ++k) c.channels.push_back(chan(kCard, 0.5f, 1.0 / 512.0, sparse, values(sparse, 7 + k)));
+  c.quat_nodes = {{1, {1000, 2000, -3000}}, {2, {0, 0, 0}}};
+  return c;
+}
+
 // A pseudo-random clip whose joints' rotations are stored as quaternions (version 5): every
 // joint's x, y, z share key frames (dense, sparse enough to be list curves, or one key), with
 // values within a quarter turn of the reference, which differs from joint to joint; the root
@@ -323,13 +417,10 @@ inline EncodedClip random_quat_clip(uint64_t seed, uint32_t frames, uint32_t joi
   uint64_t s = seed * 7 + 1;
   c.skeleton.assign_channel_columns();
   for (uint32_t j = euler_root ? 1 : 0; j < joints; ++j) {
-    keyanim::QuatNode n;
+    keyanim::QuatNode n;  // references within the unit ball; every other one the identity
     n.node = j;
-    const double h[3] = {double(lcg(s) % 1000) / 1000.0 - 0.5, double(lcg(s) % 1000) / 1000.0 - 0.5,
-                         double(lcg(s) % 1000) / 1000.0 - 0.5};
-    const double norm = std::sqrt(1.0 + h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-    n.reference[0] = float(h[0] / norm), n.reference[1] = float(h[1] / norm), n.reference[2] = float(h[2] / norm);
-    n.reference[3] = float(1.0 / norm);
+    if (j % 2 == 1)
+      for (int16_t& r : n.reference) r = int16_t(int(lcg(s) % 36000) - 18000);
     c.quat_nodes.push_back(n);
     const uint32_t first = c.skeleton.joints[j].first_channel + (j == 0 ? 3 : 0);
     const uint32_t density = j % 4 == 0 ? 1 : j % 4 == 1 ? 3 : j % 4 == 2 ? 200 : 100000;
@@ -420,12 +511,17 @@ inline void check_same_samples(const Clip& a, const Clip& b) {
 // Version 1.0 files are frozen (written by the 1.0 writer); the current writer makes the rest.
 // v4_* are the runtime profile of the v3_* file of the same name (keyanim convert --runtime),
 // and v4_archive is v3_rules as an archive file of version 4.0 (spec/test-vectors/make_v4_archive.py).
+// v5_quat and v5_blocks are archive files of version 5, v5_quat_runtime and v5_blocks_runtime
+// their runtime profiles.
 const char* const kVectorNames[] = {"v1_rules",  "v1_uniform", "v1_single",  "v1_long",    "v2_rules",
                                     "v2_long",   "v2_predict", "v3_rules",   "v3_uniform", "v3_single",
                                     "v3_long",   "v3_predict", "v3_blocks",  "v4_rules",   "v4_uniform",
-                                    "v4_single", "v4_long",    "v4_predict", "v4_blocks",  "v4_archive"};
+                                    "v4_single", "v4_long",    "v4_predict", "v4_blocks",  "v4_archive",
+                                    "v5_quat",   "v5_blocks",  "v5_quat_runtime", "v5_blocks_runtime"};
 inline EncodedClip vector_clip(const std::string& name) {
   const std::string kind = name.substr(3);
+  if (kind.starts_with("quat")) return vector_quat();
+  if (name.starts_with("v5_blocks")) return vector_quat_blocks();
   if (kind == "rules" || kind == "archive") return vector_rules();
   if (kind == "uniform") return vector_uniform();
   if (kind == "single") return vector_single();

@@ -92,7 +92,9 @@ TEST_CASE("quaternion nodes round-trip through the archive and runtime profiles 
     for (uint32_t i = 0; i < e.quat_nodes.size(); ++i) {
       const QuatNode n = l.clip.quat_node(i);
       CHECK(n.node == e.quat_nodes[i].node);
-      CHECK(std::memcmp(n.reference, e.quat_nodes[i].reference, sizeof n.reference) == 0);
+      CHECK(n.reference[0] == e.quat_nodes[i].reference[0]);
+      CHECK(n.reference[1] == e.quat_nodes[i].reference[1]);
+      CHECK(n.reference[2] == e.quat_nodes[i].reference[2]);
       const uint32_t x = l.clip.skeleton().joints[n.node].first_channel + (n.node == 0 ? 3 : 0);
       CHECK(l.clip.channel(x).stored == keyanim::StoredAs::quat_x);
       CHECK(l.clip.channel(x + 1).stored == keyanim::StoredAs::quat_y);
@@ -144,7 +146,9 @@ TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its
       // Independently: w rebuilt, the Hamilton product written out, normalized.
       const double v[3] = {stored[c], stored[c + 1], stored[c + 2]};
       const double w = std::sqrt(std::max(0.0, 1.0 - v[0] * v[0] - v[1] * v[1] - v[2] * v[2]));
-      const double r[4] = {qn.reference[0], qn.reference[1], qn.reference[2], qn.reference[3]};
+      // The reference: x, y, z in units of 2^-15, w rebuilt.
+      const double rx = qn.reference[0] / 32768.0, ry = qn.reference[1] / 32768.0, rz = qn.reference[2] / 32768.0;
+      const double r[4] = {rx, ry, rz, std::sqrt(1.0 - rx * rx - ry * ry - rz * rz)};
       double q[4] = {r[3] * v[0] + r[0] * w + r[1] * v[2] - r[2] * v[1], r[3] * v[1] - r[0] * v[2] + r[1] * w + r[2] * v[0],
                      r[3] * v[2] + r[0] * v[1] - r[1] * v[0] + r[2] * w, r[3] * w - r[0] * v[0] - r[1] * v[1] - r[2] * v[2]};
       const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
@@ -174,13 +178,13 @@ TEST_CASE("the writer refuses quaternion nodes that break section 4.7") {
   const EncodedClip good = random_quat_clip(9, 100, 4);
   REQUIRE_NOTHROW(validate_encoded_clip(good));
   EncodedClip e = good;
-  e.quat_nodes[1].reference[3] *= 1.01f;
-  refused(e, "reference not unit");
+  e.quat_nodes[1].reference[0] = e.quat_nodes[1].reference[1] = e.quat_nodes[1].reference[2] = 20000;
+  refused(e, "reference beyond the unit ball");
   e = good;
   std::swap(e.quat_nodes[0], e.quat_nodes[1]);
   refused(e, "nodes not increasing");
   e = good;
-  e.quat_nodes.push_back({4, {0, 0, 0, 1}});  // the End Site
+  e.quat_nodes.push_back({4, {0, 0, 0}});  // the End Site
   refused(e, "a node without rotation channels");
   e = good;
   const uint32_t c = e.skeleton.joints[1].first_channel;

@@ -30,8 +30,22 @@ enum class EncodeStage : uint8_t {
   measuring = 2,  // the error report, on exactly what a decoder reproduces
 };
 
+// How rotations are stored.
+enum class Rotations : uint8_t {
+  // A joint with three rotation channels (consecutive, about three axes) whose rotation stays
+  // within 145 degrees of one reference over the clip as the x, y, z curves of its rotation
+  // relative to that reference, on key frames shared by the three (spec/FORMAT.md section 4.7,
+  // a version 5 file): a pose then needs no sines and cosines and one search per joint; other
+  // joints keep their Euler channels. sample() still gives every channel's Euler angle.
+  quaternion = 0,
+  // Every rotation as its Euler channels, keyed one by one: a version 3 file, which decoders of
+  // versions 3 and 4 read, and whose keys are the BVH's own angles.
+  euler = 1,
+};
+
 struct EncodeSettings {
   KeyMode key_mode = KeyMode::error;       // Defaults to error-bounded.
+  Rotations rotations = Rotations::quaternion;  // Defaults to quaternion.
   double tolerance = 0.05;                 // Defaults to 0.05 (percent of the skeleton size).
   bool tolerance_in_percent = true;        // Defaults to true; false: file length units.
   double shell = kDefaultShellPercent;     // Defaults to 2 (percent of the skeleton size): distance of

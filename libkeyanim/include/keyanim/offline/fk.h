@@ -37,11 +37,11 @@ using Quat = std::array<double, 4>;  // x, y, z, w (glTF's and keyanim::Transfor
 // verification): such a node's rotation channels hold x, y, z of its rotation relative to its
 // reference, and its rotation is keyanim/rotation.h's stored_rotation in binary64, not the
 // product of Euler angles. Per node, the index of its QuatNode (-1: Euler channels); per
-// QuatNode, its reference widened to binary64 and the column of its x.
+// QuatNode, its reference widened to binary64, its node and the column of its x.
 struct QuatForms {
   std::vector<int32_t> of_node;
   std::vector<std::array<double, 4>> reference;
-  std::vector<uint32_t> column;
+  std::vector<uint32_t> node, column;
   QuatForms() = default;
   // `nodes` follow section 4.7 (increasing, each quaternion_capable); channel columns assigned.
   QuatForms(const Skeleton& skeleton, const std::vector<QuatNode>& nodes);
@@ -100,8 +100,10 @@ void world_positions(const Skeleton& skeleton, const double* frame_row, const do
 // sin and cos of an angle in degrees, exactly as FK computes them.
 void sin_cos_deg(double deg, double& s, double& c) noexcept;
 // World positions and world rotations (R_world of each node; an End Site's is its parent's).
+// With `quats`, the row is a clip's stored values (QuatForms).
 void world_pose(const Skeleton& skeleton, const double* frame_row, std::vector<Vec3>& positions,
-                std::vector<Mat3>& rotations, PositionReading reading = PositionReading::replace);
+                std::vector<Mat3>& rotations, PositionReading reading = PositionReading::replace,
+                const QuatForms* quats = nullptr);
 
 // World positions for every frame: result[f * node_count + j]. Throws Error (invalid_argument)
 // if the values do not fill frames x channels or the channel columns are not consistent.

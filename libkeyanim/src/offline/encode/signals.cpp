@@ -7,6 +7,7 @@
 #include "keyanim/offline/error.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/offline/number_text.h"
+#include "offline/encode/rotations.h"
 #include "offline/encode/spare.h"
 #include "offline/parallel.h"
 
@@ -89,7 +90,7 @@ void check_motion(const Motion& m, unsigned threads) {
     throw Error(ErrorKind::malformed, "joint positions overflow (beyond 1e37 in file units)");
 }
 
-ChannelLayout channel_layout(const Skeleton& s) {
+ChannelLayout channel_layout(const Skeleton& s, const std::vector<QuatNode>& quats) {
   ChannelLayout out;
   out.node.resize(s.channel_count());
   out.rotation.resize(out.node.size());
@@ -100,10 +101,23 @@ ChannelLayout channel_layout(const Skeleton& s) {
       out.rotation[joint.first_channel + k] = is_rotation(joint.channels[k]);
     }
   }
+  out.stored = internal::stored_kinds(s, quats);
+  out.quats = quats;
+  out.quat_of.assign(out.node.size(), UINT32_MAX);
+  for (uint32_t i = 0; i < quats.size(); ++i) {
+    const uint32_t c = internal::quat_column(s, quats[i].node);
+    out.quat_of[c] = out.quat_of[c + 1] = out.quat_of[c + 2] = i;
+  }
   return out;
 }
 
 void channel_signal(const Motion& m, const ChannelLayout& layout, uint32_t c, std::vector<double>& out) {
+  if (layout.stored[c] != internal::Stored::value) {
+    std::array<std::vector<double>, 4> q;
+    quat_signals(m, layout.quats[layout.quat_of[c]], q);
+    out = std::move(q[size_t(layout.stored[c]) - 1]);
+    return;
+  }
   const size_t stride = layout.node.size();  // not m.channel_count(): that walks the skeleton
   out.resize(m.frame_count);
   for (uint32_t f = 0; f < m.frame_count; ++f) out[f] = m.values[size_t(f) * stride + c];
@@ -120,6 +134,13 @@ Signals::Signals(const Motion& m, const ChannelLayout& layout, size_t budget, un
   values_ = take_spare<double>();
   values_.resize(size_t(frames_) * channels);
   parallel_for(channels, threads, [&](size_t c, unsigned) {
+    if (layout.stored[c] == internal::Stored::quat_x) {  // a quaternion node's three at once
+      std::array<std::vector<double>, 4> q;
+      quat_signals(m, layout.quats[layout.quat_of[c]], q);
+      for (size_t k = 0; k < 3; ++k) std::copy(q[k].begin(), q[k].end(), values_.begin() + ptrdiff_t((c + k) * frames_));
+      return;
+    }
+    if (layout.stored[c] != internal::Stored::value) return;  // y, z: with x
     std::vector<double> column;  // once per channel: not worth a per-thread buffer kept afterwards
     channel_signal(m, layout, uint32_t(c), column);
     std::copy(column.begin(), column.end(), values_.begin() + ptrdiff_t(c * frames_));
@@ -132,6 +153,18 @@ void Signals::get(const Motion& m, const ChannelLayout& layout, uint32_t c, std:
   if (values_.empty()) return channel_signal(m, layout, c, out);
   const double* column = values_.data() + size_t(c) * frames_;
   out.assign(column, column + frames_);
+}
+
+void Signals::get_quat(const Motion& m, const ChannelLayout& layout, uint32_t quat,
+                       std::array<std::vector<double>, 4>& out) const {
+  if (values_.empty()) return quat_signals(m, layout.quats[quat], out);
+  const uint32_t c = internal::quat_column(m.skeleton, layout.quats[quat].node);
+  for (uint32_t k = 0; k < 3; ++k) get(m, layout, c + k, out[k]);
+  out[3].resize(frames_);
+  for (uint32_t f = 0; f < frames_; ++f) {
+    const double x = out[0][f], y = out[1][f], z = out[2][f];
+    out[3][f] = std::sqrt(std::max(0.0, 1.0 - (x * x + y * y + z * z)));
+  }
 }
 
 void unwrap_degrees(std::vector<double>& y) {

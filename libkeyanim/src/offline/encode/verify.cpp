@@ -6,8 +6,10 @@
 #include <span>
 
 #include "keyanim/offline/container.h"
+#include "keyanim/offline/decode.h"
 #include "keyanim/offline/metrics.h"
 #include "offline/encode/channel_fit.h"
+#include "offline/encode/rotations.h"
 #include "offline/encode/spare.h"
 #include "offline/parallel.h"
 
@@ -148,10 +150,12 @@ void add_errors(const Skeleton& s, double tol, double shell, const Vec3* origina
 }
 
 // Four rows at a time: `rows` posed under readings[0] (and the add reading when both are
-// measured) into w.points (w.points_add), for the nodes w.pose marks.
+// measured) into w.points (w.points_add), for the nodes w.pose marks. `quats`: rows of stored
+// values with quaternion nodes.
 void pose_rows(const Skeleton& s, const std::array<const double*, 4>& rows, double shell,
-               std::span<const PositionReading> readings, VerifyScratch& w) {
-  measured_points(s, rows, shell, readings[0], w.points, w.pose.data(), readings.size() > 1 ? &w.points_add : nullptr);
+               std::span<const PositionReading> readings, VerifyScratch& w, const QuatForms* quats = nullptr) {
+  measured_points(s, rows, shell, readings[0], w.points, w.pose.data(), readings.size() > 1 ? &w.points_add : nullptr,
+                  quats);
 }
 
 }  // namespace
@@ -188,9 +192,10 @@ OriginalPoints::OriginalPoints(const Motion& m, double shell, size_t budget, uns
 
 OriginalPoints::~OriginalPoints() { give_spare(std::move(points_), budget_); }
 
-void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tol,
+void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels, TangentRule rule, double tolerance,
                    double shell, uint32_t first, uint32_t count, FrameMarks& marks, std::vector<OverNode>& over,
-                   VerifyScratch& w, const OriginalPoints* originals) {
+                   VerifyScratch& w, const OriginalPoints* originals, const QuatForms* quats) {
+  const double tol = quats ? tolerance * (1.0 - kQuatMargin) : tolerance;
   uint8_t* check = marks.check();
   const auto& joints = m.skeleton.joints;
   const size_t n_ch = channels.size(), nodes = joints.size();
@@ -225,12 +230,21 @@ void verify_window(const Motion& m, const std::vector<EncodedChannel>& channels,
           w.row[k][c] = w.cursors[c].at(f);
       }
     }
-    auto original = [&](size_t k) { return m.values.data() + size_t(w.frames[i + std::min(k, size - 1)]) * n_ch; };
+    // The original's row; with quaternion nodes, in the same stored form as the decoded rows
+    // (their rotation channels hold x, y, z of the original's relative rotation), so that one
+    // FK pass poses both.
+    auto original = [&](size_t k) -> const double* {
+      const uint32_t f = w.frames[i + std::min(k, size - 1)];
+      if (!quats) return m.values.data() + size_t(f) * n_ch;
+      w.original[k].resize(n_ch);
+      stored_row(m, *quats, f, w.original[k].data());
+      return w.original[k].data();
+    };
     auto decoded = [&](size_t k) -> const double* { return w.row[std::min(k, size - 1)].data(); };
     if (held)
-      pose_rows(m.skeleton, {decoded(0), decoded(1), decoded(2), decoded(3)}, shell, readings, w);
+      pose_rows(m.skeleton, {decoded(0), decoded(1), decoded(2), decoded(3)}, shell, readings, w, quats);
     else
-      pose_rows(m.skeleton, {original(0), decoded(0), original(1), decoded(1)}, shell, readings, w);
+      pose_rows(m.skeleton, {original(0), decoded(0), original(1), decoded(1)}, shell, readings, w, quats);
     for (size_t r = 0; r < readings.size(); ++r) {
       const auto& points = r == 0 ? w.points : w.points_add;
       for (size_t k = 0; k < size; ++k) {
@@ -262,18 +276,19 @@ ErrorReport measure_encoded(const Motion& m, const EncodedClip& enc, double shel
   // The clip's skeleton is the motion's (encode copies it): one skeleton poses both.
   std::vector<ErrorAccumulator> parts(windows, ErrorAccumulator(m.skeleton, shell));
   parallel_for(windows, threads, [&](size_t w, unsigned) {
-    Cursor cursor;
-    if (cursor.prepare(clip) != Status::ok) throw std::bad_alloc();
-    std::vector<float> row(n_ch);
-    std::array<std::vector<double>, 2> decoded{std::vector<double>(n_ch), std::vector<double>(n_ch)};
-    auto decode = [&](uint32_t f, std::vector<double>& out) {
-      clip.sample(double(f), row, &cursor);
-      std::copy(row.begin(), row.end(), out.begin());
-      return out.data();
-    };
-    auto original = [&](uint32_t f) { return m.values.data() + size_t(f) * n_ch; };
     const uint32_t end = uint32_t(std::min<size_t>(frames, (w + 1) * window));
     uint32_t f = uint32_t(w * window);
+    FrameDecoder decoder;  // the window's frames, as decode_motion makes them
+    ResampleOptions range;
+    range.first_frame = f, range.last_frame = end - 1;
+    decoder.start(clip, range);
+    const uint32_t start = f;
+    std::array<std::vector<double>, 2> decoded{std::vector<double>(n_ch), std::vector<double>(n_ch)};
+    auto decode = [&](uint32_t g, std::vector<double>& out) {
+      decoder.frame(g - start, out);
+      return out.data();
+    };
+    auto original = [&](uint32_t g) { return m.values.data() + size_t(g) * n_ch; };
     for (; f + 1 < end; f += 2) {  // two frames at a time: one FK poses four rows
       const double* a = decode(f, decoded[0]);
       parts[w].add_frames(f, {original(f), a, original(f + 1), decode(f + 1, decoded[1])});

@@ -132,6 +132,7 @@ struct VerifyScratch {
   std::vector<ChannelCursor> cursors;
   std::vector<uint32_t> frames;                // of the window, to verify
   std::array<std::vector<double>, 4> row;      // decoded
+  std::array<std::vector<double>, 2> original; // with quaternion nodes: the original's, in stored form
   std::array<std::vector<uint8_t>, 4> measure; // per node: its error is measured
   std::vector<uint8_t> pose;                   // per node: posed (for any frame of the group)
   std::array<std::vector<double>, 4> error;    // per node: the largest distance over the readings
@@ -150,13 +151,20 @@ struct VerifyScratch {
 // list is the one measuring every node would give. Frames with a node over stay marked kOver;
 // the others are unmarked. `first` is a multiple of 64 where windows run concurrently.
 // `originals`: the original's points, if held (the same result, in fewer instructions).
+// `quats`: the clip's quaternion nodes (their rotation from stored x, y, z, in binary64). Their
+// angles as a converter writes them (decode.h) pose the same points within a few ulps, so a
+// node of such a clip is over from tolerance x (1 - kQuatMargin): what passes here passes
+// measure_error on the decoded motion.
+inline constexpr double kQuatMargin = 1e-9;
 void verify_window(const Motion& original, const std::vector<EncodedChannel>& channels, TangentRule rule,
                    double tolerance, double shell, uint32_t first, uint32_t count, FrameMarks& marks,
-                   std::vector<OverNode>& over, VerifyScratch& scratch, const OriginalPoints* originals = nullptr);
+                   std::vector<OverNode>& over, VerifyScratch& scratch, const OriginalPoints* originals = nullptr,
+                   const QuatForms* quats = nullptr);
 
 // The error report of `clip` (valid: validate_encoded_clip) against `original`, on the clip a
-// decoder loads (to_clip) sampled by Clip::sample at every frame: measure_error's numbers,
-// computed window by window on `threads` threads, shell distance `shell`.
+// decoder loads (to_clip) decoded at every frame as decode_motion does (a quaternion node's
+// angles in binary64): measure_error's numbers, computed window by window on `threads`
+// threads, shell distance `shell`.
 ErrorReport measure_encoded(const Motion& original, const EncodedClip& clip, double shell, unsigned threads);
 
 }  // namespace keyanim::offline

@@ -176,6 +176,7 @@ Status Bank::clip(uint32_t i, Clip& out, ErrorInfo* err, const DecodeLimits& lim
   m.member_offset = e.offset;
   m.dictionary = state_->dictionary.get();
   m.runtime = idx.runtime;
+  m.bank_major = idx.major;
   // The clip keeps the bank's state (and so its bytes and dictionary) alive.
   Status s = internal::check_member_padding(idx, i, err);
   if (s == Status::ok)

@@ -35,9 +35,10 @@ Status check_header(std::span<const uint8_t> bytes, BankIndex& out, ErrorInfo* e
   // A file of one clip (any version) is named as such rather than as a bank of a bad version.
   if (!(flags & kHeaderBank))
     return fail(err, Status::invalid_argument, "bank header", 12, "a file of one clip, not a bank (Header_Flags bit 2 is clear)");
-  if (major != kRuntimeVersionMajor)
+  if (major != kRuntimeVersionMajor && major != kQuatFormatVersionMajor)
     return fail(err, Status::unsupported_version, "bank header", 8,
-                "major version " + std::to_string(major) + " (banks are version 4, section 10)");
+                "major version " + std::to_string(major) + " (banks are versions 4 and 5, section 10)");
+  out.major = major;
   if (flags & kHeaderReservedMask & ~(kHeaderRuntime | kHeaderMember | kHeaderBank))
     return fail(err, Status::reserved_bits_set, "bank header", 12, "reserved Header_Flags bits are set");
   if (flags & kHeaderMember) return fail(err, Status::corrupt, "bank header", 12, "a bank's header has Header_Flags bit 1 (Member) set");

@@ -19,6 +19,7 @@ struct BankIndex {
   std::span<const uint8_t> bytes;
   uint32_t clips = 0;
   uint32_t skeletons = 0;
+  uint16_t major = 0;  // 4, or 5 when a member may be of version 5
   bool runtime = false;
   BankIndexLayout layout;
 

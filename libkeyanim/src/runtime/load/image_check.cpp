@@ -133,9 +133,8 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
     if (at_index<uint32_t>(c, lay, L::quat_column, i) != quat_column(skeleton, node))
       return fail_in(Status::corrupt, c, lay.at[L::quat_column] + 4 * i, "Quat_Column[" + std::to_string(i) + "] is not its node's first rotation channel");
     nodes[i].node = node;
-    std::memcpy(nodes[i].reference, ref, sizeof ref);
-    if (!valid_reference(nodes[i].reference))
-      return fail_in(Status::corrupt, c, ref_at, "Quat_Reference " + std::to_string(i) + " is not a unit quaternion in binary32");
+    if (!reference_from_floats(ref, nodes[i]))
+      return fail_in(Status::corrupt, c, ref_at, "Quat_Reference " + std::to_string(i) + " is not a reference's binary32 quaternion (section 9.2)");
   }
   const std::vector<Stored> kinds = stored_kinds(skeleton, nodes);
   for (uint64_t ch = 0; ch < n.channels; ++ch) {

@@ -56,6 +56,7 @@ struct MemberContext {
   uint64_t member_offset = 0;
   const ZSTD_DDict* dictionary = nullptr;
   bool runtime = false;  // the bank's profile, which its members must have
+  uint16_t bank_major = 4;  // a member's major version is at most the bank's (section 10.5)
 };
 
 class Loader {

@@ -129,20 +129,20 @@ Status Loader::parse_quat(const Content& c, ClipSource& parts) {
   uint32_t count = 0;
   ByteReader r(c.data, c.size);
   if (!r.read(count) || count > node_count_ || c.size != internal::kQuatHeaderBytes + uint64_t(count) * internal::kQuatEntryBytes)
-    return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 20 x Quat_Count bytes, Quat_Count at most Node_Count");
+    return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 10 x Quat_Count bytes, Quat_Count at most Node_Count");
   parts.quat_nodes.resize(count);
   for (uint32_t i = 0; i < count; ++i) {
     QuatNode& n = parts.quat_nodes[i];
     const size_t at = r.pos();
     r.read(n.node);
-    for (float& x : n.reference) r.read(x);
+    for (int16_t& x : n.reference) r.read(x);
     const std::string entry = "QUAT entry " + std::to_string(i) + ": ";
     if (n.node >= node_count_ || (i > 0 && n.node <= parts.quat_nodes[i - 1].node))
       return fail_in(Status::corrupt, c, at, entry + "Node must be a node, in increasing order");
     if (!quaternion_capable(parts.skeleton.joints[n.node]))
       return fail_in(Status::corrupt, c, at, entry + "the node must have three consecutive rotation channels about three axes");
     if (!internal::valid_reference(n.reference))
-      return fail_in(Status::corrupt, c, at + 4, entry + "Reference must be a unit quaternion in binary32");
+      return fail_in(Status::corrupt, c, at + 4, entry + "Reference's x^2 + y^2 + z^2 must be at most 2^30");
   }
   return Status::ok;
 }

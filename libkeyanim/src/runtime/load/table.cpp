@@ -184,6 +184,9 @@ Status Loader::check_header_flags(uint16_t major, uint32_t flags) {
     return fail(Status::corrupt, "header", 12, "a bank's clip must have Header_Flags bit 1 (Member) set and bit 2 (Bank) clear");
   if (member_ != nullptr && runtime_ != member_->runtime)
     return fail(Status::corrupt, "header", 12, "a bank's clips are of the bank's profile (Header_Flags bit 0)");
+  if (member_ != nullptr && major > member_->bank_major)
+    return fail(Status::corrupt, "header", 8, "a member of version " + std::to_string(major) + " in a bank of version " +
+                                                  std::to_string(member_->bank_major));
   return Status::ok;
 }
 
@@ -292,7 +295,7 @@ Status Loader::check_declared_size(const TableEntry& e, int critical, const Clip
     case kQuatSlot:
       if (raw < kQuatHeaderBytes || (raw - kQuatHeaderBytes) % kQuatEntryBytes != 0 ||
           (raw - kQuatHeaderBytes) / kQuatEntryBytes > node_count_)
-        return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 20 x Quat_Count bytes, Quat_Count at most Node_Count");
+        return fail_in(Status::corrupt, c, 0, "QUAT must be 4 + 10 x Quat_Count bytes, Quat_Count at most Node_Count");
       break;
     default:
       if (major_ >= 3 && raw != kval_fixed_bytes(parts))
