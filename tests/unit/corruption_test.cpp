@@ -136,7 +136,7 @@ void put_f64(std::vector<uint8_t>& b, double d) {
 // The checksum of spec 3.3, or of 9.1 (XXH64, 8 bytes) for a runtime-profile file (version 4,
 // Header_Flags bit 0).
 void fix_checksum(std::vector<uint8_t>& f) {
-  if (f.size() >= 24 && f[8] == 4 && f[9] == 0 && (f[12] & 1)) {
+  if (f.size() >= 24 && (f[8] == 4 || f[8] == 5) && f[9] == 0 && (f[12] & 1)) {  // the runtime profile's XXH64
     const uint64_t x = keyanim::internal::xxh64_of(f.data(), f.size() - 8);
     for (int i = 0; i < 8; ++i) f[f.size() - 8 + size_t(i)] = uint8_t(x >> (8 * i));
     return;

@@ -1,5 +1,6 @@
 // The spec's test vectors (spec/test-vectors/): each loads and equals its hand-built clip, and
-// matches the values of reference_decoder.py, an independent Python implementation.
+// matches the values of reference_decoder.py, an independent Python implementation: its stored
+// values (Appendix A) bit for bit, and in version 5 its quaternion nodes' rotations (4.7).
 #include <doctest/doctest.h>
 #include <zstd.h>
 
@@ -214,11 +215,32 @@ TEST_CASE("test vectors match the independent reference decoder") {
       for (size_t k = 0; k < jt.channels.size(); ++k)
         CHECK(nodes[i]["channels"].arr[k].str == keyanim::channel_name(jt.channels[k]));
     }
+    // Version 5: the quaternion nodes, and at each position their rotations (section 4.7, in
+    // binary64) beside the stored values (Appendix A).
+    const auto& quats = j["quat_nodes"].arr;
+    REQUIRE(quats.size() == clip.quat_node_count());
+    for (uint32_t q = 0; q < quats.size(); ++q) {
+      CHECK(quats[q]["node"].num == clip.quat_node(q).node);
+      for (size_t k = 0; k < 3; ++k) CHECK(quats[q]["reference"].arr[k].num == clip.quat_node(q).reference[k]);
+    }
     const auto& samples = j["samples"].arr;
     REQUIRE(samples.size() >= 8);
     std::vector<float> out(clip.channel_count());
+    std::vector<keyanim::Transform> pose(clip.skeleton().joints.size());
     for (const Json& s : samples) {
-      REQUIRE(clip.sample(s["position"].num, out) == Status::ok);
+      REQUIRE(clip.sample_stored(s["position"].num, out) == Status::ok);
+      REQUIRE(clip.sample_local(s["position"].num, pose) == Status::ok);
+      const auto& rotations = s["rotations"].arr;
+      REQUIRE(rotations.size() == quats.size());
+      for (uint32_t q = 0; q < quats.size(); ++q) {  // q and -q are one rotation
+        const float* got = pose[clip.quat_node(q).node].rotation;
+        double same = 0.0, opposite = 0.0;
+        for (size_t k = 0; k < 4; ++k) {
+          const double e = rotations[q].arr[k].num;
+          same = std::max(same, std::fabs(got[k] - e)), opposite = std::max(opposite, std::fabs(got[k] + e));
+        }
+        CHECK_MESSAGE(std::min(same, opposite) <= 2e-6, "position " << s["position"].num << " quaternion node " << q);
+      }
       const auto& expected = s["values"].arr;
       REQUIRE(expected.size() == out.size());
       for (size_t c = 0; c < out.size(); ++c) {
