@@ -46,7 +46,7 @@ inline void flush_image(const keyanim::Clip& clip) {
   flush_vec(img.lists), flush_vec(img.list_values), flush_vec(img.interp), flush_vec(img.tension);
   flush_vec(img.key_count), flush_vec(img.fixed_frame), flush_vec(img.euler->groups);
   flush_vec(img.euler->node), flush_vec(img.euler->column), flush_vec(img.rig->moves);
-  flush_vec(img.quat_node), flush_vec(img.quat_column), flush_vec(img.quat_reference), flush_vec(img.track_first);
+  flush_vec(img.quat_node), flush_vec(img.quat_column), flush_vec(img.quat_reference);
   flush_vec(img.notes), flush_vec(img.rig->skeleton.joints);
   for (const auto& j : img.rig->skeleton.joints) flush_vec(j.channels), flush_vec(j.name);
 }

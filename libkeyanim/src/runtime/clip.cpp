@@ -81,14 +81,20 @@ double Clip::duration() const noexcept {
 namespace {
 
 // The quaternion node (index into the image's) whose rotation channels hold channel c, and
-// which of them c is (0 x, 1 y, 2 z); false for a channel of its own values.
+// which of them c is (0 x, 1 y, 2 z); false for a channel of its own values. The image lists
+// the quaternion tracks, then the other quaternion nodes, each group in node order (so in
+// column order): a search in each.
 bool quat_of_channel(const Image& img, uint32_t c, uint32_t& quat, uint32_t& component) noexcept {
-  const auto& col = img.quat_column;
-  const auto it = std::upper_bound(col.begin(), col.end(), c);  // columns increase with the nodes
-  if (it == col.begin() || c - *(it - 1) >= 3) return false;
-  quat = static_cast<uint32_t>(it - col.begin()) - 1;
-  component = c - *(it - 1);
-  return true;
+  const uint32_t* col = img.quat_column.data();
+  const uint32_t groups[3] = {0, img.quat_tracks, static_cast<uint32_t>(img.quat_column.size())};
+  for (int g = 0; g < 2; ++g) {
+    const uint32_t* it = std::upper_bound(col + groups[g], col + groups[g + 1], c);
+    if (it == col + groups[g] || c - *(it - 1) >= 3) continue;
+    quat = static_cast<uint32_t>(it - col) - 1;
+    component = c - *(it - 1);
+    return true;
+  }
+  return false;
 }
 
 // Quaternion node i's Euler angles (degrees, its rotation channels' order) from its stored x,
@@ -147,6 +153,7 @@ QuatNode Clip::quat_node(uint32_t i) const noexcept {
   const Image& img = KEYANIM_IMG;
   QuatNode n;
   if (i >= img.quat_node.size()) return n;
+  i = internal::quat_in_node_order(img, i);
   n.node = img.quat_node[i];
   float ref[4];
   for (uint32_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];

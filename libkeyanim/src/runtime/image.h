@@ -25,7 +25,9 @@
 // A quaternion node's three curves share their key frames (version 5), so they share a record:
 // its track's. Such a record has the Mask, three Value_Bits (x, y, z: bytes 8-10) and
 // Context_Bits (byte 11), the Context from bit 96, then the three Bases, then the three curves'
-// Values one after the other: one search of the mask gives the window of all three.
+// Values one after the other: one search of the mask gives the window of all three. Quaternion
+// track t's curves are t, T + t and 2T + t (T tracks: their x's, then their y's, then their
+// z's, before every other curve), so that the facts of 4 or 8 tracks load at once.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -122,20 +124,20 @@ struct Image {
   std::span<const float> first_value, last_value;  // v_0 and v_{n-1}
   std::span<const uint32_t> curve_linear;    // all ones: linear interpolation
   std::span<const uint32_t> curve_channel;   // curve i's output column (channel)
-  // Quaternion nodes (version 5; none before): their nodes, the column of each one's x, and
-  // their references as four arrays of quat_lanes floats (x's, y's, z's, w's; padding lanes
-  // the identity), so that 4 or 8 nodes' rotations are built per register.
+  // Quaternion nodes (version 5; none before): their nodes (the quat_tracks whose curves are
+  // block curves first, each group in node order), the column of each one's x, and their
+  // references as four arrays of quat_lanes floats (x's, y's, z's, w's; padding lanes the
+  // identity), so that 4 or 8 nodes' rotations are built per register.
   std::span<const uint32_t> quat_node, quat_column;
   std::span<const float> quat_reference;
   uint32_t quat_lanes = 0;
+  uint32_t quat_tracks = 0;
   // The Euler nodes' rotation groups (pose.cpp): the rig's when the clip has no quaternion
   // node, else `own_euler`, made for the clip's Euler nodes when it attaches (plan_rotations).
   const EulerGroups* euler = nullptr;
   EulerGroups own_euler;
-  // Block tracks: a quaternion node's three block curves are one track (one record per block),
-  // every other block curve a track of its own. track_first[t]: its first curve (increasing);
-  // empty without quaternion nodes, where track t is curve t.
-  std::span<const uint32_t> track_first;
+  // Block tracks, one record per block each: quaternion track t < quat_tracks (curves t,
+  // quat_tracks + t, 2 quat_tracks + t), then every other block curve alone.
   uint32_t block_tracks = 0;
   uint32_t block_count = 0;
   // [block * block_tracks + track]: byte offset in payload; kPrefetchRecords extra zeros at the
@@ -147,7 +149,10 @@ struct Image {
   struct TrackOf {
     uint32_t track, component, curves;  // curves: 1, or kTrackCurves
   };
-  TrackOf track_of(uint32_t curve) const noexcept;  // image_build.cpp
+  TrackOf track_of(uint32_t curve) const noexcept {
+    if (curve >= 3 * quat_tracks) return {curve - 2 * quat_tracks, 0, 1};
+    return {curve % quat_tracks, curve / quat_tracks, kTrackCurves};
+  }
   const uint8_t* track_record(uint32_t block, uint32_t track) const noexcept {
     return payload.data() + record_offset[size_t(block) * block_tracks + track];
   }
@@ -331,10 +336,22 @@ inline CurveFields curve_fields(const uint8_t* rec, uint32_t k, uint32_t curves,
 inline const uint8_t* curve_record(const Image& img, uint32_t block, uint32_t curve, CurveFields& f) noexcept {
   const Image::TrackOf t = img.track_of(curve);
   uint32_t base_bits[kTrackCurves];
-  for (uint32_t k = 0; k < t.curves; ++k) base_bits[k] = img.curves[curve - t.component + k].base_bits;
+  for (uint32_t k = 0; k < t.curves; ++k) base_bits[k] = img.curves[t.curves == 1 ? curve : t.track + k * img.quat_tracks].base_bits;
   const uint8_t* rec = img.track_record(block, t.track);
   f = curve_fields(rec, t.component, t.curves, base_bits);
   return rec;
+}
+
+// The index in img's quaternion arrays of its i-th quaternion node in node order (the arrays
+// list the tracks, then the others, each group in node order): a merge of the two, O(Q).
+inline uint32_t quat_in_node_order(const Image& img, uint32_t i) noexcept {
+  uint32_t a = 0, b = img.quat_tracks;
+  const uint32_t end = static_cast<uint32_t>(img.quat_node.size());
+  for (uint32_t k = 0;; ++k) {
+    const bool take_a = a < img.quat_tracks && (b == end || img.quat_node[a] < img.quat_node[b]);
+    if (k == i) return take_a ? a : b;
+    take_a ? ++a : ++b;
+  }
 }
 
 // The window's four values (see Window).

@@ -134,8 +134,7 @@ struct Arrays {
   std::vector<uint32_t> curve_linear, curve_channel;
   std::vector<uint32_t> quat_node, quat_column;
   std::vector<float> quat_reference;  // 4 x lanes(Q): x's, y's, z's, w's
-  std::vector<uint32_t> track_first;  // with quaternion nodes only
-  uint32_t block_tracks = 0;
+  uint32_t quat_tracks = 0;
   uint32_t block_count = 0;
   std::vector<uint32_t> record_offset;
   std::vector<uint8_t> payload;  // records, then kPayloadPadding zero bytes
@@ -149,16 +148,14 @@ void put_array(uint8_t* imag, const ImageLayout& at, ImageLayout::Array a, const
 // IMAG's bytes (spec section 9.2) in a zeroed, 8-aligned buffer, and the image pointed into it.
 void write_imag(const Arrays& a, Image& img) {
   const ImageCounts n{a.interp.size(), a.curves.size(), a.block_curves, a.block_count, a.list_frames.size(),
-                      a.payload.size() - kPayloadPadding, a.quat_node.size(), a.block_tracks};
+                      a.payload.size() - kPayloadPadding, a.quat_node.size(), a.quat_tracks};
   const ImageLayout at(n);
   auto words = std::make_shared<uint64_t[]>(at.end() / 8);
   uint8_t* imag = reinterpret_cast<uint8_t*>(words.get());
-  // Version 5's Quat_Count and Block_Track_Count; version 4's Image_Reserved (0) without
-  // quaternion nodes.
-  const bool v5 = n.quat_nodes > 0;
+  // Version 5's Quat_Count and Quat_Track_Count (version 4's Image_Reserved: 0 without
+  // quaternion nodes).
   const uint32_t header[8] = {kBlockShift, uint32_t(n.curves), uint32_t(n.block_curves), uint32_t(n.blocks),
-                              uint32_t(n.list_keys), uint32_t(n.payload), uint32_t(n.quat_nodes),
-                              v5 ? uint32_t(n.block_tracks) : 0u};
+                              uint32_t(n.list_keys), uint32_t(n.payload), uint32_t(n.quat_nodes), uint32_t(n.quat_tracks)};
   std::memcpy(imag, header, sizeof header);
   using L = ImageLayout;
   put_array(imag, at, L::interpolation, a.interp);
@@ -184,7 +181,6 @@ void write_imag(const Arrays& a, Image& img) {
   put_array(imag, at, L::quat_node, a.quat_node);
   put_array(imag, at, L::quat_column, a.quat_column);
   put_array(imag, at, L::quat_reference, a.quat_reference);
-  put_array(imag, at, L::track_first, a.track_first);
   put_array(imag, at, L::lists, a.lists);
   put_array(imag, at, L::list_frames, a.list_frames);
   put_array(imag, at, L::list_values, a.list_values);
@@ -224,15 +220,7 @@ std::span<const T> array_at(std::span<const uint8_t> imag, const ImageLayout& at
 ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept {
   uint32_t h[8];
   std::memcpy(h, imag.data(), sizeof h);
-  return {channels, h[1], h[2], h[3], h[4], h[5], h[6], h[6] > 0 ? h[7] : h[2]};
-}
-
-Image::TrackOf Image::track_of(uint32_t curve) const noexcept {
-  if (track_first.empty()) return {curve, 0, 1};
-  const uint32_t t = static_cast<uint32_t>(std::upper_bound(track_first.begin(), track_first.end(), curve) -
-                                           track_first.begin()) - 1;
-  const uint32_t next = t + 1 < block_tracks ? track_first[t + 1] : block_curves;
-  return {t, curve - track_first[t], next - track_first[t]};
+  return {channels, h[1], h[2], h[3], h[4], h[5], h[6], h[7]};
 }
 
 void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) noexcept {
@@ -265,54 +253,106 @@ void attach_image(Image& img, std::span<const uint8_t> imag, uint32_t channels) 
   img.quat_column = array_at<uint32_t>(imag, at, L::quat_column, n.quat_nodes);
   img.quat_lanes = static_cast<uint32_t>(L::lanes(n.quat_nodes));
   img.quat_reference = array_at<float>(imag, at, L::quat_reference, 4 * uint64_t(img.quat_lanes));
-  img.track_first = array_at<uint32_t>(imag, at, L::track_first, n.quat_nodes > 0 ? n.block_tracks : 0);
-  img.block_tracks = static_cast<uint32_t>(n.block_tracks);
+  img.quat_tracks = static_cast<uint32_t>(n.quat_tracks);
+  img.block_tracks = static_cast<uint32_t>(n.block_tracks());
   img.block_count = static_cast<uint32_t>(n.blocks);
-  img.record_offset = array_at<uint32_t>(imag, at, L::record_offset, n.blocks * n.block_tracks + kPrefetchRecords);
+  img.record_offset = array_at<uint32_t>(imag, at, L::record_offset, n.blocks * n.block_tracks() + kPrefetchRecords);
   img.payload = array_at<uint8_t>(imag, at, L::payload, n.payload + kPayloadPadding);
 }
 
 namespace {
 
-// The quaternion nodes' arrays (node, x's column, references in lanes) and the block tracks: a
-// quaternion node's three block curves (consecutive: its channels are, and block curves are in
-// channel order) make one track, any other block curve one of its own.
+// Whether the quaternion node's curves are block curves: a quaternion track (its three curves
+// have one key count: all block curves or none).
+bool is_quat_track(const ClipSource& src, const QuatNode& n, uint64_t blocks) {
+  const uint32_t keys = src.channels[quat_column(src.skeleton, n.node)].key_count;
+  return keys >= 2 && !is_list_curve(keys, blocks);
+}
+
+// The channels of the curves in IMAG's order (spec 9.2): the quaternion tracks' x's, then their
+// y's, then their z's (node order), the other block curves in channel order, then the list
+// curves in channel order. `tracks` gets the number of quaternion tracks.
+std::vector<uint32_t> curve_order(const ClipSource& src, uint64_t blocks, uint32_t& tracks) {
+  std::vector<uint32_t> order, x;
+  for (const QuatNode& n : src.quat_nodes)
+    if (is_quat_track(src, n, blocks)) x.push_back(quat_column(src.skeleton, n.node));
+  tracks = static_cast<uint32_t>(x.size());
+  for (uint32_t k = 0; k < kTrackCurves; ++k)
+    for (uint32_t c : x) order.push_back(c + k);
+  std::vector<uint8_t> taken(src.channels.size(), 0);
+  for (uint32_t c : order) taken[c] = 1;
+  for (int list = 0; list < 2; ++list)
+    for (uint32_t c = 0; c < src.channels.size(); ++c) {
+      const uint32_t n = src.channels[c].key_count;
+      if (n >= 2 && !taken[c] && is_list_curve(n, blocks) == (list == 1)) order.push_back(c);
+    }
+  return order;
+}
+
+// Channel c as the next curve (a list curve's keys into the lists too).
+void add_curve(const ClipSource& src, uint32_t c, Arrays& a) {
+  const SourceChannel& sc = src.channels[c];
+  const uint32_t n = sc.key_count;
+  const uint64_t blocks = (uint64_t(src.frame_count) + kBlockFrames - 1) / kBlockFrames;
+  const int64_t* q = src.q.data() + sc.first_key;
+  const uint32_t* k = src.frames.data() + sc.first_key;
+  Curve cv;
+  cv.step = sc.step;
+  const auto [lo, hi] = std::minmax_element(q, q + n);
+  cv.q_base = *lo;
+  cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
+  if (is_list_curve(n, blocks)) {
+    a.lists.push_back({static_cast<uint32_t>(a.list_frames.size()), n});
+    a.list_frames.insert(a.list_frames.end(), k, k + n);
+    for (uint32_t i = 0; i < n; ++i) a.list_values.push_back(dequantize(q[i], sc.step));
+    a.list_q.insert(a.list_q.end(), q, q + n);
+  }
+  a.curve_s.push_back(tension_to_s(sc.tension));
+  a.first_frame.push_back(static_cast<float>(k[0]));
+  a.last_frame.push_back(static_cast<float>(k[n - 1]));
+  a.first_value.push_back(dequantize(q[0], sc.step));
+  a.last_value.push_back(dequantize(q[n - 1], sc.step));
+  a.curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
+  a.curve_of[c] = static_cast<uint32_t>(a.curves.size());
+  a.curves.push_back(cv);
+  a.curve_channel.push_back(c);
+}
+
+// The quaternion nodes' arrays (node, x's column, references in lanes): the quaternion tracks
+// first, in node order, then the others.
 void add_quat_arrays(const ClipSource& src, Arrays& a) {
   const size_t q = src.quat_nodes.size();
   const size_t lanes = ImageLayout::lanes(q);
+  const uint64_t blocks = (uint64_t(src.frame_count) + kBlockFrames - 1) / kBlockFrames;
   a.quat_reference.assign(4 * lanes, 0.0f);
   for (size_t i = q; i < lanes; ++i) a.quat_reference[3 * lanes + i] = 1.0f;  // the identity
-  for (size_t i = 0; i < q; ++i) {
-    const QuatNode& n = src.quat_nodes[i];
-    a.quat_node.push_back(n.node);
-    a.quat_column.push_back(quat_column(src.skeleton, n.node));
-    float ref[4];
-    reference_of(n, ref);
-    for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = ref[k];
-  }
-  const std::vector<Stored> kinds = stored_kinds(src.skeleton, src.quat_nodes);
-  a.block_tracks = 0;
-  for (uint32_t i = 0; i < a.block_curves; ++a.block_tracks) {
-    if (q > 0) a.track_first.push_back(i);
-    i += kinds[a.curve_channel[i]] == Stored::quat_x ? kTrackCurves : 1;
-  }
+  for (int tracks = 1; tracks >= 0; --tracks)
+    for (const QuatNode& n : src.quat_nodes) {
+      if (is_quat_track(src, n, blocks) != (tracks == 1)) continue;
+      const size_t i = a.quat_node.size();
+      a.quat_node.push_back(n.node);
+      a.quat_column.push_back(quat_column(src.skeleton, n.node));
+      float ref[4];
+      reference_of(n, ref);
+      for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = ref[k];
+    }
 }
 
-// Track t's curves: their Keys and Curve facts.
+// Block track t's curves: their Keys and Curve facts.
 struct TrackCurves {
   uint32_t curves = 1;
   Keys keys[kTrackCurves];
   Curve cv[kTrackCurves];
 };
-TrackCurves track_curves(const ClipSource& src, const Arrays& a, size_t t) {
+TrackCurves track_curves(const ClipSource& src, const Arrays& a, uint32_t t) {
   TrackCurves tc;
-  const uint32_t first = a.track_first.empty() ? uint32_t(t) : a.track_first[t];
-  const uint32_t next = a.track_first.empty() || t + 1 == a.track_first.size() ? a.block_curves : a.track_first[t + 1];
-  tc.curves = a.track_first.empty() ? 1 : next - first;
+  const uint32_t T = a.quat_tracks;
+  tc.curves = t < T ? kTrackCurves : 1;
   for (uint32_t k = 0; k < tc.curves; ++k) {
-    const SourceChannel& sc = src.channels[a.curve_channel[first + k]];
+    const uint32_t curve = t < T ? t + k * T : t + 2 * T;
+    const SourceChannel& sc = src.channels[a.curve_channel[curve]];
     tc.keys[k] = {src.frames.data() + sc.first_key, src.q.data() + sc.first_key, sc.key_count};
-    tc.cv[k] = a.curves[first + k];
+    tc.cv[k] = a.curves[curve];
   }
   return tc;
 }
@@ -329,52 +369,20 @@ Arrays build_arrays(const ClipSource& src) {
   a.fixed_value.assign(channels, 0.0f);
   a.fixed_frame.assign(channels, 0);
   const uint64_t blocks = (uint64_t(src.frame_count) + kBlockFrames - 1) / kBlockFrames;
-  // Block curves first, then list curves (two passes over the channels).
-  for (int pass = 0; pass < 2; ++pass) {
-    for (size_t c = 0; c < channels; ++c) {
-      const SourceChannel& sc = src.channels[c];
-      if (pass == 0) {
-        a.interp[c] = sc.interp;
-        a.tension[c] = sc.tension;
-        a.key_count[c] = sc.key_count;
-      }
-      if (sc.key_count < 2) {
-        if (pass == 1) continue;
-        if (sc.key_count == 1) {
-          a.fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
-          a.fixed_frame[c] = src.frames[sc.first_key];
-        }
-        a.fixed_channels.push_back(static_cast<uint32_t>(c));
-        continue;
-      }
-      const uint32_t n = sc.key_count;
-      if (is_list_curve(n, blocks) != (pass == 1)) continue;
-      const int64_t* q = src.q.data() + sc.first_key;
-      const uint32_t* k = src.frames.data() + sc.first_key;
-      Curve cv;
-      cv.step = sc.step;
-      const auto [lo, hi] = std::minmax_element(q, q + n);
-      cv.q_base = *lo;
-      cv.base_bits = bit_width(static_cast<uint64_t>(*hi - *lo));
-      if (pass == 1) {
-        a.lists.push_back({static_cast<uint32_t>(a.list_frames.size()), n});
-        a.list_frames.insert(a.list_frames.end(), k, k + n);
-        for (uint32_t i = 0; i < n; ++i) a.list_values.push_back(dequantize(q[i], sc.step));
-        a.list_q.insert(a.list_q.end(), q, q + n);
-      }
-      a.curve_s.push_back(tension_to_s(sc.tension));
-      a.first_frame.push_back(static_cast<float>(k[0]));
-      a.last_frame.push_back(static_cast<float>(k[n - 1]));
-      a.first_value.push_back(dequantize(q[0], sc.step));
-      a.last_value.push_back(dequantize(q[n - 1], sc.step));
-      a.curve_linear.push_back(sc.interp == Interpolation::linear ? ~0u : 0u);
-      a.curve_of[c] = static_cast<uint32_t>(a.curves.size());
-      a.curves.push_back(cv);
-      a.curve_channel.push_back(static_cast<uint32_t>(c));
+  for (size_t c = 0; c < channels; ++c) {
+    const SourceChannel& sc = src.channels[c];
+    a.interp[c] = sc.interp;
+    a.tension[c] = sc.tension;
+    a.key_count[c] = sc.key_count;
+    if (sc.key_count >= 2) continue;
+    if (sc.key_count == 1) {
+      a.fixed_value[c] = dequantize(src.q[sc.first_key], sc.step);
+      a.fixed_frame[c] = src.frames[sc.first_key];
     }
-    if (pass == 0) a.block_curves = static_cast<uint32_t>(a.curves.size());
+    a.fixed_channels.push_back(static_cast<uint32_t>(c));
   }
-
+  for (const uint32_t c : curve_order(src, blocks, a.quat_tracks)) add_curve(src, uint32_t(c), a);
+  a.block_curves = static_cast<uint32_t>(a.curves.size() - a.lists.size());
   const size_t nc = a.curves.size();
   // The per-curve arrays are read 4 curves at a time: pad them to whole lanes (never "in" a
   // segment: the padding lanes are clamped constants).
@@ -387,10 +395,11 @@ Arrays build_arrays(const ClipSource& src) {
   a.curve_linear.resize(lanes, 0u);
   a.block_count = nc == 0 ? 0 : static_cast<uint32_t>(blocks);
   add_quat_arrays(src, a);
-  const size_t nt = a.block_tracks;  // records: at most 4 per key of a block curve
+  const size_t nt = a.block_curves - 2 * size_t(a.quat_tracks);  // block tracks: records at most 4 per key
+
   const size_t records = size_t(a.block_count) * nt;
   std::vector<RecordPlan> plans(records);
-  for (size_t t = 0; t < nt; ++t) {
+  for (uint32_t t = 0; t < nt; ++t) {
     const TrackCurves tc = track_curves(src, a, t);
     int64_t first = 0, last = 0;  // the block's keys: [first, last)
     const Keys& keys = tc.keys[0];  // the track's key frames
@@ -413,7 +422,7 @@ Arrays build_arrays(const ClipSource& src) {
     total += plans[r].size_bytes;
   }
   a.payload.assign(total + kPayloadPadding, 0);
-  for (size_t t = 0; t < nt; ++t) {
+  for (uint32_t t = 0; t < nt; ++t) {
     const TrackCurves tc = track_curves(src, a, t);
     for (uint32_t b = 0; b < a.block_count; ++b) {
       const size_t r = size_t(b) * nt + t;

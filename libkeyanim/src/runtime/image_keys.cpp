@@ -48,11 +48,12 @@ ClipSource image_keys(const Image& img) {
   src.rule = img.rule;
   src.skeleton = img.rig->skeleton;
   src.notes = img.notes;
-  src.quat_nodes.resize(img.quat_node.size());
-  for (size_t i = 0; i < src.quat_nodes.size(); ++i) {
-    src.quat_nodes[i].node = img.quat_node[i];
+  src.quat_nodes.resize(img.quat_node.size());  // in node order, as QUAT lists them
+  for (uint32_t i = 0; i < src.quat_nodes.size(); ++i) {
+    const uint32_t j = quat_in_node_order(img, i);
+    src.quat_nodes[i].node = img.quat_node[j];
     float ref[4];
-    for (size_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
+    for (size_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + j];
     reference_from_floats(ref, src.quat_nodes[i]);  // checked when the image was
   }
   src.channels.resize(img.interp.size());

@@ -19,11 +19,13 @@ struct ImageCounts {
   uint64_t blocks = 0;        // B
   uint64_t list_keys = 0;     // M
   uint64_t payload = 0;       // P
-  // Version 5: quaternion nodes (Q) and block tracks (nt: a quaternion node's three block curves
-  // are one track, with one record per block; every other block curve is a track of its own).
-  // Version 4 has none: Q = 0 and nt = nb.
+  // Version 5: quaternion nodes (Q), of which T quaternion tracks (their three curves are block
+  // curves, with one record per block for the three). Version 4 has none: Q = T = 0.
   uint64_t quat_nodes = 0;
-  uint64_t block_tracks = 0;
+  uint64_t quat_tracks = 0;
+  // Block tracks, one record each per block: the T quaternion tracks, then every other block
+  // curve alone (needs 3 T <= block_curves).
+  uint64_t block_tracks() const noexcept { return block_curves - 2 * quat_tracks; }
 };
 
 // Byte offsets of the arrays from IMAG's first byte, in section 9.2's order; `end` is Raw_Size.
@@ -32,8 +34,7 @@ struct ImageLayout {
   enum Array : uint32_t {
     interpolation, tension, key_count, curve_of, fixed_value, fixed_frame, fixed_channels, curves,
     curve_s, first_frame, last_frame, first_value, last_value, curve_linear, curve_channel, quat_node,
-    quat_column, quat_reference, track_first, lists, list_frames, list_values, list_q, record_offset,
-    payload, kArrays
+    quat_column, quat_reference, lists, list_frames, list_values, list_q, record_offset, payload, kArrays
   };
   uint64_t at[kArrays + 1];  // at[kArrays] is the end
   uint64_t used[kArrays];    // each array's bytes without its padding
@@ -42,17 +43,17 @@ struct ImageLayout {
   static uint64_t pad8(uint64_t n) noexcept { return (n + 7) & ~uint64_t(7); }
   static uint64_t lanes(uint64_t curves) noexcept { return (curves + 3) & ~uint64_t(3); }
 
-  // Needs curves <= channels and block_curves <= curves (version 4: quat_nodes 0, block_tracks
-  // = block_curves, and the version 5 arrays are empty).
+  // Needs curves <= channels, block_curves <= curves and 3 quat_tracks <= block_curves (version
+  // 4: no quaternion node, and the version 5 arrays are empty).
   explicit ImageLayout(const ImageCounts& n) noexcept {
     const uint64_t c = n.channels, l = lanes(n.curves), q = n.quat_nodes;
     const uint64_t bytes[kArrays] = {  // section 9.2's table, row by row
         c,     4 * c, 4 * c,                    4 * c,  4 * c,  4 * c,  4 * (c - n.curves), kCurveBytes * n.curves,
         4 * l, 4 * l, 4 * l,                    4 * l,  4 * l,  4 * l,  4 * n.curves,
-        4 * q, 4 * q, 16 * lanes(q), q > 0 ? 4 * n.block_tracks : 0,
+        4 * q, 4 * q, 16 * lanes(q),
         8 * (n.curves - n.block_curves),
         4 * n.list_keys, 4 * n.list_keys, 8 * n.list_keys,
-        4 * (n.blocks * n.block_tracks + kImageTailEntries), n.payload + kImageTailEntries};
+        4 * (n.blocks * n.block_tracks() + kImageTailEntries), n.payload + kImageTailEntries};
     at[0] = kImageHeaderBytes;
     for (uint32_t a = 0; a < kArrays; ++a) used[a] = bytes[a], at[a + 1] = at[a] + pad8(bytes[a]);
   }

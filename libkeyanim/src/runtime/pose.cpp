@@ -224,11 +224,15 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
     const uint32_t end = whole ? g.node_count : lower_index(node, g.node_count, last);
     group_rotations<kWide>(eg, g, begin, end, values, column0, first, out);
   }
-  const uint32_t quats = static_cast<uint32_t>(img.quat_node.size());
-  if (quats == 0) return;
-  const uint32_t begin = whole ? 0 : lower_index(img.quat_node.data(), quats, first);
-  const uint32_t end = whole ? quats : lower_index(img.quat_node.data(), quats, last);
-  quat_rotations<kWide>(img, begin, end, values, column0, first, out);
+  // The quaternion nodes: the tracks, then the others, each group in node order.
+  const uint32_t groups[3] = {0, img.quat_tracks, static_cast<uint32_t>(img.quat_node.size())};
+  for (int g = 0; g < 2; ++g) {
+    const uint32_t* node = img.quat_node.data() + groups[g];
+    const uint32_t n = groups[g + 1] - groups[g];
+    const uint32_t begin = whole ? 0 : lower_index(node, n, first);
+    const uint32_t end = whole ? n : lower_index(node, n, last);
+    quat_rotations<kWide>(img, groups[g] + begin, groups[g] + end, values, column0, first, out);
+  }
 }
 
 KEYANIM_INLINE inline void compose_impl(const Image& img, Transform* out) noexcept {

@@ -123,12 +123,13 @@ template <bool kPopcnt>
   dequantize4(rec, w, cv, b.values[i]);
 }
 
-// A quaternion track's three curves (from `curve`) into lanes i .. i + 2, or only its
-// component `only` (< 3) into lane i: one search of the shared mask gives every curve's window
-// (their key frames are the same); their Bases, then their Values, follow one another.
+// Quaternion track `track`'s curves x, y, z (indices curve[0..2]) into lanes lane[0..2]: one
+// search of the shared mask gives every curve's window (their key frames are the same); their
+// Bases, then their Values, follow one another. `only` < 3: that component alone.
 template <bool kPopcnt>
-[[gnu::always_inline]] inline void gather_track(const BlockView& v, uint32_t track, uint32_t curve, Batch& b,
-                                                uint32_t i, uint32_t only = kTrackCurves) noexcept {
+[[gnu::always_inline]] inline void gather_track(const BlockView& v, uint32_t track, const uint32_t (&curve)[3],
+                                                Batch& b, const uint32_t (&lane)[3],
+                                                uint32_t only = kTrackCurves) noexcept {
   const uint8_t* rec = v.payload + v.offsets[track];
   uint64_t mask;
   std::memcpy(&mask, rec, 8);
@@ -136,40 +137,31 @@ template <bool kPopcnt>
   Window w;
   const uint32_t count = window_frames<kPopcnt>(rec, mask, kTrackRecordBitsAt / 8, kw, v.upto, w.frame);
   const uint64_t values = popcount64<kPopcnt>(mask) + kContextKeys;  // per curve
+  const Curve* cv[3] = {v.curves + curve[0], v.curves + curve[1], v.curves + curve[2]};
   uint64_t base_at = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw;
-  uint64_t at = base_at;
-  for (uint32_t k = 0; k < kTrackCurves; ++k) at += v.curves[curve + k].base_bits;
+  uint64_t at = base_at + cv[0]->base_bits + cv[1]->base_bits + cv[2]->base_bits;
   for (uint32_t k = 0; k < kTrackCurves; ++k) {
-    const Curve& cv = v.curves[curve + k];
     const uint32_t vw = rec[8 + k];
     if (only == kTrackCurves || only == k) {
-      const uint32_t lane = only == kTrackCurves ? i + k : i;
-      w.base = read_bits(rec, base_at, cv.base_bits);
+      w.base = read_bits(rec, base_at, cv[k]->base_bits);
       w.value_bits = vw;
       w.at = at + uint64_t(count) * vw;
-      std::memcpy(b.frames[lane], w.frame, sizeof w.frame);
-      dequantize4(rec, w, cv, b.values[lane]);
+      std::memcpy(b.frames[lane[k]], w.frame, sizeof w.frame);
+      dequantize4(rec, w, *cv[k], b.values[lane[k]]);
     }
-    base_at += cv.base_bits;
+    base_at += cv[k]->base_bits;
     at += values * vw;
   }
 }
 
-// Block curve `curve`, whichever track holds it (a lookup: for the paths that list channels).
+// Block curve `curve`, whichever track holds it (for the paths that list channels).
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void gather_curve(const Image& img, const BlockView& v, uint32_t curve, Batch& b,
                                                 uint32_t i) noexcept {
-  if (img.track_first.empty()) return gather<kPopcnt>(v, curve, curve, b, i);
   const Image::TrackOf t = img.track_of(curve);
   if (t.curves == 1) return gather<kPopcnt>(v, t.track, curve, b, i);
-  gather_track<kPopcnt>(v, t.track, curve - t.component, b, i, t.component);
-}
-
-// The curves of block track t: kTrackCurves or 1.
-inline uint32_t track_width(const Image& img, uint32_t t) noexcept {
-  if (img.track_first.empty()) return 1;
-  const uint32_t next = t + 1 < img.block_tracks ? img.track_first[t + 1] : img.block_curves;
-  return next - img.track_first[t];
+  const uint32_t T = img.quat_tracks;
+  gather_track<kPopcnt>(v, t.track, {t.track, T + t.track, 2 * T + t.track}, b, {i, i, i}, t.component);
 }
 
 // A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
@@ -246,12 +238,14 @@ template <> struct IntLanes<F4> { using type = I4; };
 template <> struct IntLanes<F8> { using type = I8; };
 #endif
 
-// Appendix A for the lanes of one V (F4: 4, F8: 8) from lane i.
+// Appendix A for the lanes of one V (F4: 4, F8: 8) from batch lane lane0 + i, whose facts are
+// x's from index i.
 template <class V, bool kAdjusted>
-KEYANIM_INLINE inline void evaluate_lanes(const Batch& b, const Facts& x, const V& f, const V& rel, uint32_t i, float* res) noexcept {
+KEYANIM_INLINE inline void evaluate_lanes(const Batch& b, const Facts& x, const V& f, const V& rel, uint32_t lane0,
+                                          uint32_t i, float* res) noexcept {
   typename IntLanes<V>::type k[4];
   V p[4];
-  load_keys(b, i, k, p);
+  load_keys(b, lane0 + i, k, p);
   // Lengths rounded once from the integer differences, as Appendix A; the uniform rule is
   // the step-adjusted one with equal lengths (tangent_scale then gives exactly 1).
   const V k0 = to_float(k[1]), k1 = to_float(k[2]), len = to_float(k[2] - k[1]);
@@ -264,55 +258,61 @@ KEYANIM_INLINE inline void evaluate_lanes(const Batch& b, const Facts& x, const 
   const V before = cmp_not_gt(f, V::load(x.first_frame + i));
   const V after = cmp_ge(f, V::load(x.last_frame + i));
   const V direct = select(before, V::load(x.first_value + i), select(after, V::load(x.last_value + i), p[1]));
-  select(mask_or(mask_or(before, after), cmp_eq(rel, k0)), direct, value).store(res + i);
+  select(mask_or(mask_or(before, after), cmp_eq(rel, k0)), direct, value).store(res + lane0 + i);
 }
 
-// Pass two: Appendix A for lanes [0, count), count a multiple of 4; 8 lanes at a time when
-// kWide (the v3 copy), the last 4 if any on their own (the facts arrays are padded to 4).
+// Pass two: Appendix A for batch lanes [lane0, lane0 + count), count a multiple of 4, whose
+// facts are x's [0, count); 8 lanes at a time when kWide (the v3 copy), the last 4 if any on
+// their own (the facts arrays are padded to 4).
 template <bool kAdjusted, bool kWide>
-KEYANIM_INLINE inline void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t count,
-                                   float* res) noexcept {
+KEYANIM_INLINE inline void evaluate(const Batch& b, const Facts& x, const Position& at, uint32_t lane0,
+                                   uint32_t count, float* res) noexcept {
   uint32_t i = 0;
 #if KEYANIM_WIDE_LANES
   if constexpr (kWide) {
     const F8 f(at.f), rel(at.rel);
-    for (; i + 8 <= count; i += 8) evaluate_lanes<F8, kAdjusted>(b, x, f, rel, i, res);
+    for (; i + 8 <= count; i += 8) evaluate_lanes<F8, kAdjusted>(b, x, f, rel, lane0, i, res);
   }
 #endif
   const F4 f(at.f), rel(at.rel);
-  for (; i < count; i += 4) evaluate_lanes<F4, kAdjusted>(b, x, f, rel, i, res);
+  for (; i < count; i += 4) evaluate_lanes<F4, kAdjusted>(b, x, f, rel, lane0, i, res);
 }
 
 template <bool kWide>
 KEYANIM_INLINE inline void evaluate(const Image& img, const Batch& b, const Facts& x, const Position& at,
-                                   uint32_t count, float* res) noexcept {
+                                   uint32_t count, float* res, uint32_t lane0 = 0) noexcept {
   if (img.rule == TangentRule::step_adjusted)
-    evaluate<true, kWide>(b, x, at, count, res);
+    evaluate<true, kWide>(b, x, at, lane0, count, res);
   else
-    evaluate<false, kWide>(b, x, at, count, res);
+    evaluate<false, kWide>(b, x, at, lane0, count, res);
 }
 
-Facts batch_facts(const Batch& b) {
-  return {b.s, b.first_frame, b.last_frame, b.first_value, b.last_value, b.linear};
+// The facts copied into the batch, from lane `lane0`.
+Facts batch_facts(const Batch& b, uint32_t lane0 = 0) {
+  return {b.s + lane0, b.first_frame + lane0, b.last_frame + lane0, b.first_value + lane0, b.last_value + lane0,
+          b.linear + lane0};
+}
+// The image's facts of curves [first, ...).
+Facts image_facts(const Image& img, uint32_t first) {
+  return {img.curve_s.data() + first,      img.first_frame.data() + first, img.last_frame.data() + first,
+          img.first_value.data() + first, img.last_value.data() + first,  img.curve_linear.data() + first};
 }
 
-// The two passes over chunks of `count` lanes at position f: size(base, count) says how many
-// lanes the chunk from `base` takes (at most kChunk), fill(b, at, view, base, m) gathers lanes
-// [base, base + m) into b, facts(b, base) says where their per-curve facts are, emit(res, base,
-// m) writes the results.
-template <bool kWide, class Size, class Fill, class FactsOf, class Emit>
-[[gnu::always_inline]] inline void run_chunks(const Image& img, float f, uint32_t count, Size size, Fill fill,
-                                              FactsOf facts, Emit emit) noexcept {
+// The two passes over chunks of lanes [from, count) at position `at`: fill(b, at, view, base,
+// m) gathers lanes [base, base + m) into b, facts(b, base, m) says where their per-curve facts
+// are, emit(res, base, m) writes the results.
+template <bool kWide, class Fill, class FactsOf, class Emit>
+[[gnu::always_inline]] inline void run_chunks(const Image& img, const Position& at, const BlockView& view,
+                                              uint32_t from, uint32_t count, Fill fill, FactsOf facts,
+                                              Emit emit) noexcept {
   Batch b;
   alignas(16) float res[kChunk];
-  const Position at = position(img, f);
-  const BlockView view = block_view(img, at);
-  for (uint32_t base = 0, m = 0; base < count; base += m) {
-    m = size(base, count);
+  for (uint32_t base = from, m = 0; base < count; base += m) {
+    m = std::min(kChunk, count - base);
     fill(b, at, view, base, m);
     const uint32_t lanes = (m + 3) & ~3u;
     for (uint32_t i = m; i < lanes; ++i) set_fixed(b, i, 0.0f);
-    evaluate<kWide>(img, b, facts(b, base), at, lanes, res);
+    evaluate<kWide>(img, b, facts(b, base, m), at, lanes, res);
     emit(res, base, m);
   }
 }
@@ -336,12 +336,12 @@ template <bool kPopcnt, bool kWide>
       copy_facts(img, curve, b, i);
     }
   };
-  auto facts = [](const Batch& b, uint32_t) KEYANIM_INLINE { return batch_facts(b); };
+  auto facts = [](const Batch& b, uint32_t, uint32_t) KEYANIM_INLINE { return batch_facts(b); };
   auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
     std::memcpy(out + base, res, m * sizeof(float));
   };
-  auto size = [](uint32_t base, uint32_t n) KEYANIM_INLINE { return std::min(kChunk, n - base); };
-  run_chunks<kWide>(img, f, count, size, fill, facts, emit);
+  const Position at = position(img, f);
+  run_chunks<kWide>(img, at, block_view(img, at), 0, count, fill, facts, emit);
 }
 
 // A record's largest size in bytes (spec 9.3: 10 bytes, four contexts of up to 31 bits, a base
@@ -363,10 +363,10 @@ constexpr uint64_t kRecordBytesBound = 512;
   // one range of the image (spec 9.2's order; an empty array lies where it would start).
   using L = ImageLayout;
   static_assert(L::curves == L::fixed_channels + 1 && L::curve_channel == L::curves + 7 &&
-                    L::track_first == L::curve_channel + 4,
-                "fixed_channels, curves, curve_s .. curve_linear, curve_channel, quat_node .. track_first are consecutive");
+                    L::quat_reference == L::curve_channel + 3,
+                "fixed_channels, curves, curve_s .. curve_linear, curve_channel, quat_node .. quat_reference are consecutive");
   const auto* from = reinterpret_cast<const uint8_t*>(img.fixed_channels.data());
-  const auto* to = reinterpret_cast<const uint8_t*>(img.track_first.data() + img.track_first.size());
+  const auto* to = reinterpret_cast<const uint8_t*>(img.quat_reference.data() + img.quat_reference.size());
   prefetch_bytes(from, size_t(to - from));
   if (!img.fixed_channels.empty()) prefetch_array(img.fixed_value.data(), img.fixed_value.size());  // by channel
   if (img.block_tracks == 0) return;
@@ -376,48 +376,70 @@ constexpr uint64_t kRecordBytesBound = 512;
   if (first < last) prefetch_array(view.payload + first, std::min(last - first, img.block_curves * kRecordBytesBound));
 }
 
-// Every curve in order, written to its channel; the fixed channels separately. The per-curve
-// facts are read from the image directly (the arrays are padded to whole SIMD lanes).
+// Quaternion tracks [t0, t0 + n) (n <= 8): their x's into batch lanes [0, g), y's into [g, 2g),
+// z's into [2g, 3g) (g: n rounded up to 4), evaluated with each curve's facts where the arrays
+// hold them for all g lanes (a whole group), else with facts copied into the batch; written to
+// their channels.
+template <bool kPopcnt, bool kWide>
+[[gnu::always_inline]] inline void sample_quat_group(const Image& img, const Position& at, const BlockView& view,
+                                                     uint32_t t0, uint32_t n, Batch& b, float* res,
+                                                     float* out) noexcept {
+  const uint32_t T = img.quat_tracks, g = (n + 3) & ~3u;
+  const bool whole = n == g;
+  for (uint32_t j = 0; j < n; ++j) {
+    const uint32_t t = t0 + j;
+    const uint32_t curve[3] = {t, T + t, 2 * T + t}, lane[3] = {j, g + j, 2 * g + j};
+    gather_track<kPopcnt>(view, t, curve, b, lane);
+    if (!whole)
+      for (uint32_t k = 0; k < kTrackCurves; ++k) copy_facts(img, curve[k], b, lane[k]);
+  }
+  for (uint32_t j = n; j < g; ++j)
+    for (uint32_t k = 0; k < kTrackCurves; ++k) set_fixed(b, k * g + j, 0.0f);
+  for (uint32_t k = 0; k < kTrackCurves; ++k)
+    evaluate<kWide>(img, b, whole ? image_facts(img, t0 + k * T) : batch_facts(b, k * g), at, g, res, k * g);
+  const uint32_t* channel = img.curve_channel.data();
+  for (uint32_t k = 0; k < kTrackCurves; ++k)
+    for (uint32_t j = 0; j < n; ++j) out[channel[t0 + j + k * T]] = res[k * g + j];
+}
+
+// Every curve, written to its channel; the fixed channels separately. The quaternion tracks
+// first, 8 at a time (24 lanes); then the other curves in chunks, their facts read from the
+// image directly where the arrays (padded to whole groups of 4) hold the chunk's lanes.
 template <bool kPopcnt, bool kWide>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
-  if (img.block_count > 0) {
-    const Position at = position(img, f);
-    prefetch_pose(img, block_view(img, at), at.block);
-  }
+  const Position at = position(img, f);
+  const BlockView view = block_view(img, at);
+  if (img.block_count > 0) prefetch_pose(img, view, at.block);
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
-  // Chunks end between tracks: a quaternion track's curves are gathered together.
-  uint32_t track = 0;
-  auto size = [&](uint32_t base, uint32_t count) KEYANIM_INLINE {
-    uint32_t m = 0;
-    for (uint32_t t = track; base + m < img.block_curves; ++t) {
-      const uint32_t w = track_width(img, t);
-      if (m + w > kChunk) return m;
-      m += w;
+  const uint32_t T = img.quat_tracks;
+  if (T > 0) {
+    Batch b;
+    alignas(16) float res[kChunk];
+    static_assert(3 * 8 <= kChunk, "a group of 8 quaternion tracks fits a batch");
+    for (uint32_t t0 = 0; t0 < T; t0 += 8)
+      sample_quat_group<kPopcnt, kWide>(img, at, view, t0, std::min(8u, T - t0), b, res, out);
+  }
+  const uint32_t nb = img.block_curves, padded = static_cast<uint32_t>(img.curve_s.size());
+  auto copied = [padded](uint32_t base, uint32_t m) { return base + ((m + 3) & ~3u) > padded; };
+  auto fill = [&](Batch& b, const Position& p, const BlockView& v, uint32_t base, uint32_t m) KEYANIM_INLINE {
+    const bool copy = copied(base, m);  // the facts' lanes run past the arrays
+    for (uint32_t i = 0; i < m; ++i) {
+      const uint32_t curve = base + i;
+      if (curve < nb)
+        gather<kPopcnt>(v, curve - 2 * T, curve, b, i);
+      else
+        gather_list(img, curve, p, b, i);
+      if (copy) copy_facts(img, curve, b, i);
     }
-    return std::min(kChunk, count - base);
   };
-  auto fill = [&](Batch& b, const Position& at, const BlockView& view, uint32_t base, uint32_t m) KEYANIM_INLINE {
-    uint32_t i = 0;
-    for (; i < m && base + i < img.block_curves; ++track) {
-      if (track_width(img, track) == 1) {
-        gather<kPopcnt>(view, track, base + i, b, i);
-        ++i;
-      } else {
-        gather_track<kPopcnt>(view, track, base + i, b, i);
-        i += kTrackCurves;
-      }
-    }
-    for (; i < m; ++i) gather_list(img, base + i, at, b, i);
-  };
-  auto facts = [&](const Batch&, uint32_t base) KEYANIM_INLINE {
-    return Facts{img.curve_s.data() + base,      img.first_frame.data() + base, img.last_frame.data() + base,
-                 img.first_value.data() + base, img.last_value.data() + base,  img.curve_linear.data() + base};
+  auto facts = [&](const Batch& b, uint32_t base, uint32_t m) KEYANIM_INLINE {
+    return copied(base, m) ? batch_facts(b) : image_facts(img, base);
   };
   auto emit = [&](const float* res, uint32_t base, uint32_t m) KEYANIM_INLINE {
     const uint32_t* channel = img.curve_channel.data() + base;
     for (uint32_t i = 0; i < m; ++i) out[channel[i]] = res[i];
   };
-  run_chunks<kWide>(img, f, static_cast<uint32_t>(img.curves.size()), size, fill, facts, emit);
+  run_chunks<kWide>(img, at, view, 3 * T, static_cast<uint32_t>(img.curves.size()), fill, facts, emit);
 }
 
 // One copy per CPU level (internal/cpu.h); popcnt from the popcnt level on, 8 lanes at v3.

@@ -1,6 +1,7 @@
 // IMAG, the runtime profile's image (spec/FORMAT.md sections 9.2 to 9.4): every structure rule,
 // in time proportional to the channels, curves, list keys and records (not the keys), after
 // which the sampler may read the bytes in place.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <cstring>
@@ -37,8 +38,8 @@ bool same_bits(float a, float b) noexcept { return float_bits(a) == float_bits(b
 const char* const kArrayNames[L::kArrays] = {
     "Interpolation", "Tension", "Key_Count", "Curve_Of", "Fixed_Value", "Fixed_Frame", "Fixed_Channels",
     "Curves", "Curve_S", "First_Frame", "Last_Frame", "First_Value", "Last_Value", "Curve_Linear",
-    "Curve_Channel", "Quat_Node", "Quat_Column", "Quat_Reference", "Track_First", "Lists", "List_Frames",
-    "List_Values", "List_Q", "Record_Offset", "Payload"};
+    "Curve_Channel", "Quat_Node", "Quat_Column", "Quat_Reference", "Lists", "List_Frames", "List_Values",
+    "List_Q", "Record_Offset", "Payload"};
 
 }  // namespace
 
@@ -58,8 +59,8 @@ Status Loader::check_image(const Content& c, const ClipSource& parts, const Skel
   if (n.block_curves > n.curves) return fail_in(Status::corrupt, c, 8, "Block_Curve_Count is above Curve_Count");
   if (n.quat_nodes > skeleton.joints.size())
     return fail_in(Status::corrupt, c, 24, "Quat_Count " + std::to_string(n.quat_nodes) + " is above Node_Count");
-  if (n.block_tracks > n.block_curves || (n.quat_nodes == 0 && major_ >= kQuatFormatVersionMajor && h[7] != n.block_curves))
-    return fail_in(Status::corrupt, c, 28, "Block_Track_Count must be the block tracks' count (Block_Curve_Count without quaternion nodes)");
+  if (n.quat_tracks > n.quat_nodes || 3 * n.quat_tracks > n.block_curves)
+    return fail_in(Status::corrupt, c, 28, "Quat_Track_Count is above Quat_Count, or its curves above Block_Curve_Count");
   const uint64_t blocks_of_clip = (frames + kBlockFrames - 1) / kBlockFrames;
   if (n.blocks != (n.curves > 0 ? blocks_of_clip : 0))
     return fail_in(Status::corrupt, c, 12, "Block_Count must be " + std::to_string(n.curves > 0 ? blocks_of_clip : 0));
@@ -106,17 +107,17 @@ Status Loader::check_image(const Content& c, const ClipSource& parts, const Skel
   if (fixed != channels - n.curves)
     return fail_in(Status::corrupt, c, lay.at[L::fixed_channels], "Fixed_Channels must list the channels of fewer than 2 keys");
   if (Status s = check_image_curves(c, lay, n, parts); s != Status::ok) return s;
-  std::vector<uint32_t> tracks;  // each block track's first curve
-  if (Status s = check_image_quats(c, lay, n, skeleton, tracks); s != Status::ok) return s;
-  return check_image_records(c, lay, n, parts, tracks);
+  if (Status s = check_image_quats(c, lay, n, parts, skeleton); s != Status::ok) return s;
+  return check_image_records(c, lay, n, parts);
 }
 
-// Version 5: the quaternion nodes (section 4.7's rules on the skeleton and the channels) and
-// the block tracks they make, into `tracks` (each one's first curve).
-Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const Skeleton& skeleton,
-                                 std::vector<uint32_t>& tracks) {
+// Version 5: the quaternion nodes (section 4.7's rules on the skeleton and the channels), their
+// order (the tracks first), and the tracks' curves at the head of the curves (9.2).
+Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n,
+                                 const ClipSource& parts, const Skeleton& skeleton) {
+  const uint64_t blocks_of_clip = (uint64_t(parts.frame_count) + kBlockFrames - 1) / kBlockFrames;
+  const uint64_t lanes = L::lanes(n.quat_nodes), T = n.quat_tracks;
   std::vector<QuatNode> nodes(n.quat_nodes);
-  const uint64_t lanes = L::lanes(n.quat_nodes);
   for (uint64_t i = 0; i < lanes; ++i) {
     float ref[4];
     for (uint64_t k = 0; k < 4; ++k) ref[k] = at_index<float>(c, lay, L::quat_reference, k * lanes + i);
@@ -128,14 +129,29 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
     }
     const uint32_t node = at_index<uint32_t>(c, lay, L::quat_node, i);
     const uint64_t node_at = lay.at[L::quat_node] + 4 * i;
-    if (node >= skeleton.joints.size() || (i > 0 && node <= nodes[i - 1].node) || !quaternion_capable(skeleton.joints[node]))
-      return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "] must be a node with three consecutive rotation channels about three axes, in increasing order");
-    if (at_index<uint32_t>(c, lay, L::quat_column, i) != quat_column(skeleton, node))
+    // The tracks (nodes whose curves are block curves) first, then the others, each increasing.
+    const bool ordered = i == 0 || i == T || node > nodes[i - 1].node;
+    if (node >= skeleton.joints.size() || !ordered || !quaternion_capable(skeleton.joints[node]))
+      return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "] must be a node with three consecutive rotation channels about three axes, the tracks' first, each group increasing");
+    const uint32_t column = quat_column(skeleton, node);
+    if (at_index<uint32_t>(c, lay, L::quat_column, i) != column)
       return fail_in(Status::corrupt, c, lay.at[L::quat_column] + 4 * i, "Quat_Column[" + std::to_string(i) + "] is not its node's first rotation channel");
+    const uint32_t keys = at_index<uint32_t>(c, lay, L::key_count, column);
+    if ((keys >= 2 && !is_list_curve(keys, blocks_of_clip)) != (i < T))
+      return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "]: the first Quat_Track_Count nodes must be those whose curves are block curves");
+    for (uint32_t k = 0; i < T && k < kTrackCurves; ++k)
+      if (at_index<uint32_t>(c, lay, L::curve_channel, i + k * T) != column + k)
+        return fail_in(Status::corrupt, c, lay.at[L::curve_channel] + 4 * (i + k * T), "quaternion track " + std::to_string(i) + "'s curves must be t, T + t, 2T + t");
     nodes[i].node = node;
     if (!reference_from_floats(ref, nodes[i]))
       return fail_in(Status::corrupt, c, ref_at, "Quat_Reference " + std::to_string(i) + " is not a reference's binary32 quaternion (section 9.2)");
   }
+  std::vector<uint8_t> listed(skeleton.joints.size(), 0);  // no node twice (the two groups are each increasing)
+  for (uint64_t i = 0; i < n.quat_nodes; ++i) {
+    if (listed[nodes[i].node]++)
+      return fail_in(Status::corrupt, c, lay.at[L::quat_node] + 4 * i, "Quat_Node lists node " + std::to_string(nodes[i].node) + " twice");
+  }
+  std::sort(nodes.begin(), nodes.end(), [](const QuatNode& a, const QuatNode& b) { return a.node < b.node; });
   const std::vector<Stored> kinds = stored_kinds(skeleton, nodes);
   for (uint64_t ch = 0; ch < n.channels; ++ch) {
     if (kinds[ch] != Stored::quat_y && kinds[ch] != Stored::quat_z) continue;
@@ -145,16 +161,6 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
         at_index<uint32_t>(c, lay, L::key_count, ch) != at_index<uint32_t>(c, lay, L::key_count, x))
       return fail_in(Status::corrupt, c, lay.at[L::key_count] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
   }
-  for (uint32_t i = 0; i < n.block_curves;) {
-    tracks.push_back(i);
-    i += kinds[at_index<uint32_t>(c, lay, L::curve_channel, i)] == Stored::quat_x ? kTrackCurves : 1;
-  }
-  if (tracks.size() != n.block_tracks)
-    return fail_in(Status::corrupt, c, 28, "Block_Track_Count must be " + std::to_string(tracks.size()) + ", the block tracks' count");
-  if (n.quat_nodes > 0)
-    for (uint64_t t = 0; t < tracks.size(); ++t)
-      if (at_index<uint32_t>(c, lay, L::track_first, t) != tracks[t])
-        return fail_in(Status::corrupt, c, lay.at[L::track_first] + 4 * t, "Track_First[" + std::to_string(t) + "] must be " + std::to_string(tracks[t]));
   return Status::ok;
 }
 
@@ -179,9 +185,10 @@ Status Loader::check_image_curves(const Content& c, const ImageLayout& lay, cons
     const uint64_t ch_at = lay.at[L::curve_channel] + 4 * i;
     if (ch >= channel_count_ || at_index<uint32_t>(c, lay, L::curve_of, ch) != i)
       return fail_in(Status::corrupt, c, ch_at, "Curve_Channel[" + std::to_string(i) + "] is not a channel whose Curve_Of is it");
-    const bool first_of_kind = i == 0 || i == n.block_curves;
+    // (The quaternion tracks' curves, [0, 3T), are checked with the quaternion nodes.)
+    const bool first_of_kind = i <= 3 * n.quat_tracks || i == n.block_curves;
     if (!first_of_kind && at_index<uint32_t>(c, lay, L::curve_channel, i - 1) >= ch)
-      return fail_in(Status::corrupt, c, ch_at, "curves must be in increasing channel order (block curves, then list curves)");
+      return fail_in(Status::corrupt, c, ch_at, "curves must be in increasing channel order (the quaternion tracks', then block curves, then list curves)");
     const uint32_t k = at_index<uint32_t>(c, lay, L::key_count, ch);
     if (is_list_curve(k, blocks_of_clip) != (i >= n.block_curves))
       return fail_in(Status::corrupt, c, ch_at, "curve " + std::to_string(i) + " is a list curve exactly when 4 x its keys < the blocks");
@@ -230,8 +237,8 @@ Status Loader::check_image_curves(const Content& c, const ImageLayout& lay, cons
 // Records, block after block (Record_Offset's order), track after track: offsets, sizes, widths,
 // zero bits, masks, window order; per curve the popcounts and the first and last key.
 Status Loader::check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n,
-                                   const ClipSource& parts, const std::vector<uint32_t>& tracks) {
-  const uint64_t frames = parts.frame_count, nb = n.block_curves, nt = tracks.size();
+                                   const ClipSource& parts) {
+  const uint64_t frames = parts.frame_count, nb = n.block_curves, nt = n.block_tracks(), T = n.quat_tracks;
   const uint8_t* payload = c.data + lay.at[L::payload];
   const uint64_t payload_at = lay.at[L::payload];
   std::vector<uint32_t> seen(nb, 0);        // keys so far
@@ -243,7 +250,8 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
     const uint64_t beyond = frames - uint64_t(start) >= kBlockFrames ? 0 : ~uint64_t(0) << (frames - uint64_t(start));
     for (uint64_t t = 0; t < nt; ++t) {
       const uint64_t r = b * nt + t;
-      const uint32_t i0 = tracks[t], curves = uint32_t((t + 1 < nt ? tracks[t + 1] : nb) - i0);
+      const uint32_t curves = t < T ? kTrackCurves : 1;
+      uint64_t curve[kTrackCurves] = {t < T ? t : t + 2 * T, T + t, 2 * T + t};  // its x, y, z, or its one
       const std::string record = "record " + std::to_string(r);
       const uint64_t off_at = lay.at[L::record_offset] + 4 * r;
       if (at_index<uint32_t>(c, lay, L::record_offset, r) != running)
@@ -261,7 +269,7 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
         return fail_in(Status::corrupt, c, payload_at + running + header - 1, record + ": Context_Bits above 31");
       if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, record + ": a key at or after Frame_Count");
       uint32_t base_bits[kTrackCurves];
-      for (uint32_t k = 0; k < curves; ++k) base_bits[k] = load_le<uint32_t>(c.data + curve_at(i0 + k) + 16);
+      for (uint32_t k = 0; k < curves; ++k) base_bits[k] = load_le<uint32_t>(c.data + curve_at(curve[k]) + 16);
       const uint64_t bits = curve_fields(rec, 0, curves, base_bits).end;  // the widths read are within the payload
       const uint64_t size = (bits + 7) / 8;
       if (size > n.payload - running) return fail_in(Status::corrupt, c, payload_at + running, record + " runs past the payload's end");
@@ -277,7 +285,7 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
         return fail_in(Status::corrupt, c, payload_at + running + header,
                        record + ": its context frames are not two before and two after the block's keys, increasing");
       for (uint32_t k = 0; k < curves; ++k) {
-        const uint64_t i = i0 + k;
+        const uint64_t i = curve[k];
         const CurveFields f = curve_fields(rec, k, curves, base_bits);
         const int64_t base = static_cast<int64_t>(read_bits(rec, f.base_at, base_bits[k]));
         if (load_le<int64_t>(c.data + curve_at(i)) + base > kMaxAbsQ)

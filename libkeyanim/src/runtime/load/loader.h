@@ -126,10 +126,9 @@ class Loader {
   // IMAG (image_check.cpp): the header, the channels, then the curves and lists, then the records.
   Status check_image(const Content& c, const ClipSource& parts, const Skeleton& skeleton);
   Status check_image_curves(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
-  Status check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const Skeleton& skeleton,
-                           std::vector<uint32_t>& tracks);
-  Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts,
-                             const std::vector<uint32_t>& tracks);
+  Status check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts,
+                           const Skeleton& skeleton);
+  Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
   Status run_runtime(ClipSource& parts);  // run() for the runtime profile
   // A member's skeleton as SKEL's content (MemberContext); else table entry `index`'s.
   Status get_skel(int index, Content& out);
