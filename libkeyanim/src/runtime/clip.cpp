@@ -13,6 +13,7 @@
 #include "runtime/clip_access.h"
 #include "runtime/cursor_state.h"
 #include "runtime/pose.h"
+#include "runtime/quat_tracks.h"
 #include "runtime/sampler.h"
 
 namespace keyanim {
@@ -269,9 +270,11 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
   constexpr uint32_t kBatch = 2048;
   float values[kBatch];
   if (img.interp.size() <= kBatch) {
+    // The quaternion tracks' rotations come straight from their records (quat_tracks.h).
     internal::prefetch_pose_tables(img, out.data(), nodes);
-    internal::sample_all(img, f, values);
-    internal::local_transforms(img, 0, nodes, values, reading, out.data());
+    internal::sample_all_but_quat_tracks(img, f, values);
+    internal::local_transforms(img, 0, nodes, values, reading, out.data(), true);
+    internal::quat_track_rotations(img, f, out.data());
     return Status::ok;
   }
   const auto& joints = img.rig->skeleton.joints;

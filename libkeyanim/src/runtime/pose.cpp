@@ -14,16 +14,10 @@
 #include "internal/prefetch.h"
 #include "internal/trig.h"
 #include "keyanim/rotation.h"
+#include "runtime/quat_lanes.h"
 
 namespace keyanim::internal {
 namespace {
-
-// Four (F4) or eight (F8: the AVX2 copy) nodes' rotations, one component per register: lane i
-// is node i's quaternion.
-template <class V>
-struct QuatLanes {
-  V x, y, z, w;
-};
 
 // q * (rotation about `axis` by the angle whose half has sine s and cosine c), q = (x, y, z, w):
 // each component is one product with c plus one signed product with s,
@@ -52,22 +46,6 @@ KEYANIM_INLINE inline F8 gather_lanes(const F8*, const float* values, const uint
                                       uint32_t lanes) noexcept {
   auto angle = [&](uint32_t l) KEYANIM_INLINE { return l < lanes ? values[column[l] - column0] : 0.0f; };
   return F8(V8f{angle(0), angle(1), angle(2), angle(3), angle(4), angle(5), angle(6), angle(7)});
-}
-#endif
-
-// Each lane's quaternion to its node's Transform, out[node - first].
-KEYANIM_INLINE inline void store_rotations(QuatLanes<F4> q, const uint32_t* node, uint32_t first, uint32_t lanes,
-                                           Transform* out) noexcept {
-  transpose(q.x, q.y, q.z, q.w);  // now lane rows: node 0's (x, y, z, w) in q.x, node 1's in q.y, ...
-  const F4* row[4] = {&q.x, &q.y, &q.z, &q.w};
-  for (uint32_t l = 0; l < lanes; ++l) row[l]->store(out[node[l] - first].rotation);
-}
-#if KEYANIM_WIDE_LANES
-KEYANIM_INLINE inline void store_rotations(const QuatLanes<F8>& q, const uint32_t* node, uint32_t first,
-                                           uint32_t lanes, Transform* out) noexcept {
-  store_rotations(QuatLanes<F4>{q.x.low(), q.y.low(), q.z.low(), q.w.low()}, node, first, std::min(lanes, 4u), out);
-  if (lanes > 4)
-    store_rotations(QuatLanes<F4>{q.x.high(), q.y.high(), q.z.high(), q.w.high()}, node + 4, first, lanes - 4, out);
 }
 #endif
 
@@ -106,8 +84,8 @@ KEYANIM_INLINE inline void group_rotations(const EulerGroups& eg, const EulerGro
   }
 }
 
-// Quaternion nodes i .. i + lanes - 1 (of the image's, lanes <= V's) from their stored x, y, z:
-// stored_rotation in every lane. Padding lanes read zeros and the identity reference.
+// Quaternion nodes i .. i + lanes - 1 (of the image's, lanes <= V's) from their stored x, y, z
+// in `values`: gathered into registers (padding lanes read zeros), then store_quat_rotations.
 template <class V>
 KEYANIM_INLINE inline void quat_lane_rotations(const Image& img, uint32_t i, uint32_t lanes, const float* values,
                                                uint32_t column0, uint32_t first, Transform* out) noexcept {
@@ -115,13 +93,7 @@ KEYANIM_INLINE inline void quat_lane_rotations(const Image& img, uint32_t i, uin
   V xyz[3];
   for (uint32_t k = 0; k < 3; ++k)  // column[l] + k's value: unsigned, column[l] - (column0 - k) is that
     xyz[k] = gather_lanes(static_cast<const V*>(nullptr), values, column, column0 - k, lanes);
-  const float* ref = img.quat_reference.data() + i;
-  const V r[4] = {V::load(ref), V::load(ref + img.quat_lanes), V::load(ref + 2 * size_t(img.quat_lanes)),
-                  V::load(ref + 3 * size_t(img.quat_lanes))};
-  V q[4];
-  stored_rotation<V>(r, xyz[0], xyz[1], xyz[2], q, [](V x) KEYANIM_INLINE { return sqrt_lanes(x); },
-                     [](V x) KEYANIM_INLINE { return max0(x); });
-  store_rotations(QuatLanes<V>{q[0], q[1], q[2], q[3]}, img.quat_node.data() + i, first, lanes, out);
+  store_quat_rotations(img, i, lanes, xyz[0], xyz[1], xyz[2], first, out);
 }
 
 // The rotations of the image's quaternion nodes [begin, end) (indices into its quaternion
@@ -200,7 +172,7 @@ static_assert(offsetof(Transform, reserved) == offsetof(Transform, translation) 
 
 template <bool kWide>
 KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t last, const float* values,
-                                     PositionReading reading, Transform* out) noexcept {
+                                     PositionReading reading, Transform* out, bool tracks_done) noexcept {
   const Rig& rig = *img.rig;
   const uint32_t column0 = rig.skeleton.joints[first].first_channel;  // values[0]'s column
   // Translations: OFFSETs (and reserved = 0), then the position channels.
@@ -226,7 +198,7 @@ KEYANIM_INLINE inline void local_impl(const Image& img, uint32_t first, uint32_t
   }
   // The quaternion nodes: the tracks, then the others, each group in node order.
   const uint32_t groups[3] = {0, img.quat_tracks, static_cast<uint32_t>(img.quat_node.size())};
-  for (int g = 0; g < 2; ++g) {
+  for (int g = tracks_done ? 1 : 0; g < 2; ++g) {
     const uint32_t* node = img.quat_node.data() + groups[g];
     const uint32_t n = groups[g + 1] - groups[g];
     const uint32_t begin = whole ? 0 : lower_index(node, n, first);
@@ -260,12 +232,12 @@ KEYANIM_INLINE inline void compose_impl(const Image& img, Transform* out) noexce
 
 // One copy per CPU level (internal/cpu.h), 8 lanes at v3.
 KEYANIM_V3_TARGET void local_v3(const Image& img, uint32_t first, uint32_t last, const float* values,
-                                PositionReading reading, Transform* out) noexcept {
-  local_impl<KEYANIM_WIDE_LANES != 0>(img, first, last, values, reading, out);
+                                PositionReading reading, Transform* out, bool tracks_done) noexcept {
+  local_impl<KEYANIM_WIDE_LANES != 0>(img, first, last, values, reading, out, tracks_done);
 }
 void local_plain(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
-                 Transform* out) noexcept {
-  local_impl<false>(img, first, last, values, reading, out);
+                 Transform* out, bool tracks_done) noexcept {
+  local_impl<false>(img, first, last, values, reading, out, tracks_done);
 }
 KEYANIM_V3_TARGET void compose_v3(const Image& img, Transform* out) noexcept { compose_impl(img, out); }
 void compose_plain(const Image& img, Transform* out) noexcept { compose_impl(img, out); }
@@ -273,10 +245,10 @@ void compose_plain(const Image& img, Transform* out) noexcept { compose_impl(img
 }  // namespace
 
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
-                      Transform* out) noexcept {
+                      Transform* out, bool tracks_done) noexcept {
   if (first >= last) return;
-  cpu_level() == CpuLevel::v3 ? local_v3(img, first, last, values, reading, out)
-                              : local_plain(img, first, last, values, reading, out);
+  cpu_level() == CpuLevel::v3 ? local_v3(img, first, last, values, reading, out, tracks_done)
+                              : local_plain(img, first, last, values, reading, out, tracks_done);
 }
 
 void prefetch_pose_tables(const Image& img, Transform* out, uint32_t nodes) noexcept {

@@ -9,9 +9,11 @@
 namespace keyanim::internal {
 
 // Local transforms of nodes [first, last) from the values of their channels (columns
-// skeleton.joints[first].first_channel onward, in order): out[i - first] for node i.
+// skeleton.joints[first].first_channel onward, in order): out[i - first] for node i. With
+// `tracks_done`, the quaternion tracks' rotations are left as they are (quat_track_rotations
+// writes them).
 void local_transforms(const Image& img, uint32_t first, uint32_t last, const float* values, PositionReading reading,
-                      Transform* out) noexcept;
+                      Transform* out, bool tracks_done = false) noexcept;
 
 // Asks for the cache lines local_transforms reads (the rig's pose tables) and writes (the
 // whole pose `out`, `nodes` transforms) of a whole pose, before the channels are sampled: a

@@ -14,6 +14,7 @@
 #include "internal/prefetch.h"
 #include "internal/simd.h"
 #include "internal/simd8.h"
+#include "runtime/gather.h"
 
 namespace keyanim::internal {
 namespace {
@@ -36,81 +37,6 @@ struct Facts {
   const uint32_t* linear;
 };
 
-// Where position f falls: its block, and f relative to the block's start (exact: see below).
-struct Position {
-  float f;    // the position
-  float rel;  // f - block start, exact (Sterbenz: the start is 0, or >= 64 and > f / 2)
-  uint32_t block, t;
-};
-
-Position position(const Image& img, float f) noexcept {
-  Position p;
-  p.f = f;
-  if (img.block_count == 0) return {f, f, 0, 0};
-  // Outside the clip every curve is clamped, whatever block is read; NaN never reaches here.
-  const float end = static_cast<float>((img.block_count << kBlockShift) - 1);
-  const float clamped = std::min(std::max(f, 0.0f), end);
-  p.block = static_cast<uint32_t>(clamped) >> kBlockShift;
-  const float start = static_cast<float>(p.block << kBlockShift);
-  p.t = std::min(static_cast<uint32_t>(clamped - start), kBlockFrames - 1);
-  p.rel = f - start;
-  return p;
-}
-
-// q = q_base + base + value, dequantized as Appendix A says (binary64 product, one rounding).
-// double(q_base + base) + double(value) is exact (|q| <= 2^53), so two lanes at a time with
-// SSE2 give the very same values.
-#if KEYANIM_SSE2
-[[gnu::always_inline]] inline void dequantize4(__m128i v, int64_t low, double step, float* out) noexcept {
-  const __m128d lowd = _mm_set1_pd(static_cast<double>(low)), s = _mm_set1_pd(step);
-  const __m128d a = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(v), lowd), s);
-  const __m128d b = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(v, v)), lowd), s);
-  _mm_storeu_ps(out, _mm_movelh_ps(_mm_cvtpd_ps(a), _mm_cvtpd_ps(b)));
-}
-#endif
-
-[[gnu::always_inline]] inline void dequantize4(const uint8_t* rec, const Window& w, const Curve& cv, float* out) noexcept {
-  const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
-  [[maybe_unused]] const uint32_t vw = w.value_bits;  // unused without SSE2
-#if KEYANIM_SSE2
-  if (vw <= 14) {  // the usual widths: the four values in one load, split in two 64-bit lanes
-    uint64_t x;
-    std::memcpy(&x, rec + (w.at >> 3), 8);
-    x >>= w.at & 7;  // 4 vw + 7 <= 63 bits
-    const __m128i m = _mm_set1_epi64x(static_cast<int64_t>((uint64_t(1) << vw) - 1));
-    const __m128i v = _mm_set_epi64x(static_cast<int64_t>(x >> (2 * vw)), static_cast<int64_t>(x));  // v0 v1 | v2 v3
-    const __m128i even = _mm_and_si128(v, m);                                        // v0, v2
-    const __m128i odd = _mm_and_si128(_mm_srl_epi64(v, _mm_cvtsi32_si128(static_cast<int>(vw))), m);  // v1, v3
-    dequantize4(_mm_or_si128(even, _mm_slli_epi64(odd, 32)), low, cv.step, out);
-    return;
-  }
-#endif
-  uint64_t value[4];
-  window_values(rec, w, value);
-#if KEYANIM_SSE2
-  if (vw <= 31) {
-    dequantize4(_mm_set_epi32(static_cast<int32_t>(value[3]), static_cast<int32_t>(value[2]),
-                              static_cast<int32_t>(value[1]), static_cast<int32_t>(value[0])),
-                low, cv.step, out);
-    return;
-  }
-#endif
-  for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(value[k]), cv.step);
-}
-
-// The image's arrays for one block, loaded once per pose rather than once per curve.
-struct BlockView {
-  const uint8_t* payload;
-  const uint32_t* offsets;  // the block's row of record offsets, one per track
-  const Curve* curves;
-  uint64_t upto;            // frames_upto(t): the block's keys at or before the position
-};
-
-BlockView block_view(const Image& img, const Position& at) noexcept {
-  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_tracks, img.curves.data(),
-          frames_upto(at.t)};
-}
-
 // Block curve `curve` alone in track `track`'s record into lane i.
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void gather(const BlockView& v, uint32_t track, uint32_t curve, Batch& b,
@@ -123,35 +49,19 @@ template <bool kPopcnt>
   dequantize4(rec, w, cv, b.values[i]);
 }
 
-// Quaternion track `track`'s curves x, y, z (indices curve[0..2]) into lanes lane[0..2]: one
-// search of the shared mask gives every curve's window (their key frames are the same); their
-// Bases, then their Values, follow one another. `only` < 3: that component alone.
+// Quaternion track `track`'s curves x, y, z (indices curve[0..2]) into lanes lane[0..2] (gather.h:
+// read_track); `only` < 3: that component alone.
 template <bool kPopcnt>
 [[gnu::always_inline]] inline void gather_track(const BlockView& v, uint32_t track, const uint32_t (&curve)[3],
                                                 Batch& b, const uint32_t (&lane)[3],
                                                 uint32_t only = kTrackCurves) noexcept {
-  const uint8_t* rec = v.payload + v.offsets[track];
-  uint64_t mask;
-  std::memcpy(&mask, rec, 8);
-  const uint32_t kw = rec[kTrackRecordBitsAt / 8 - 1];
-  Window w;
-  const uint32_t count = window_frames<kPopcnt>(rec, mask, kTrackRecordBitsAt / 8, kw, v.upto, w.frame);
-  const uint64_t values = popcount64<kPopcnt>(mask) + kContextKeys;  // per curve
-  const Curve* cv[3] = {v.curves + curve[0], v.curves + curve[1], v.curves + curve[2]};
-  uint64_t base_at = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw;
-  uint64_t at = base_at + cv[0]->base_bits + cv[1]->base_bits + cv[2]->base_bits;
-  for (uint32_t k = 0; k < kTrackCurves; ++k) {
-    const uint32_t vw = rec[8 + k];
-    if (only == kTrackCurves || only == k) {
-      w.base = read_bits(rec, base_at, cv[k]->base_bits);
-      w.value_bits = vw;
-      w.at = at + uint64_t(count) * vw;
-      std::memcpy(b.frames[lane[k]], w.frame, sizeof w.frame);
-      dequantize4(rec, w, *cv[k], b.values[lane[k]]);
-    }
-    base_at += cv[k]->base_bits;
-    at += values * vw;
-  }
+  int32_t frame[4];
+  float* values[3] = {nullptr, nullptr, nullptr};
+  for (uint32_t k = 0; k < kTrackCurves; ++k)
+    if (only == kTrackCurves || only == k) values[k] = b.values[lane[k]];
+  read_track<kPopcnt>(v, track, curve, frame, values);
+  for (uint32_t k = 0; k < kTrackCurves; ++k)
+    if (values[k] != nullptr) std::memcpy(b.frames[lane[k]], frame, sizeof frame);
 }
 
 // Block curve `curve`, whichever track holds it (for the paths that list channels).
@@ -405,14 +315,15 @@ template <bool kPopcnt, bool kWide>
 // Every curve, written to its channel; the fixed channels separately. The quaternion tracks
 // first, 8 at a time (24 lanes); then the other curves in chunks, their facts read from the
 // image directly where the arrays (padded to whole groups of 4) hold the chunk's lanes.
-template <bool kPopcnt, bool kWide>
+// Without kTracks, the quaternion tracks' curves are left out (their channels untouched).
+template <bool kPopcnt, bool kWide, bool kTracks = true>
 [[gnu::always_inline]] inline void sample_curves(const Image& img, float f, float* out) noexcept {
   const Position at = position(img, f);
   const BlockView view = block_view(img, at);
   if (img.block_count > 0) prefetch_pose(img, view, at.block);
   for (uint32_t c : img.fixed_channels) out[c] = img.fixed_value[c];
   const uint32_t T = img.quat_tracks;
-  if (T > 0) {
+  if (kTracks && T > 0) {
     Batch b;
     alignas(16) float res[kChunk];
     static_assert(3 * 8 <= kChunk, "a group of 8 quaternion tracks fits a batch");
@@ -422,15 +333,11 @@ template <bool kPopcnt, bool kWide>
   const uint32_t nb = img.block_curves, padded = static_cast<uint32_t>(img.curve_s.size());
   auto copied = [padded](uint32_t base, uint32_t m) { return base + ((m + 3) & ~3u) > padded; };
   auto fill = [&](Batch& b, const Position& p, const BlockView& v, uint32_t base, uint32_t m) KEYANIM_INLINE {
-    const bool copy = copied(base, m);  // the facts' lanes run past the arrays
-    for (uint32_t i = 0; i < m; ++i) {
-      const uint32_t curve = base + i;
-      if (curve < nb)
-        gather<kPopcnt>(v, curve - 2 * T, curve, b, i);
-      else
-        gather_list(img, curve, p, b, i);
-      if (copy) copy_facts(img, curve, b, i);
-    }
+    const uint32_t blocked = base < nb ? std::min(m, nb - base) : 0;
+    for (uint32_t i = 0; i < blocked; ++i) gather<kPopcnt>(v, base + i - 2 * T, base + i, b, i);
+    for (uint32_t i = blocked; i < m; ++i) gather_list(img, base + i, p, b, i);
+    if (copied(base, m))  // the facts' lanes run past the arrays
+      for (uint32_t i = 0; i < m; ++i) copy_facts(img, base + i, b, i);
   };
   auto facts = [&](const Batch& b, uint32_t base, uint32_t m) KEYANIM_INLINE {
     return copied(base, m) ? batch_facts(b) : image_facts(img, base);
@@ -451,6 +358,13 @@ KEYANIM_POPCNT_TARGET void all_popcnt(const Image& img, float f, float* out) noe
   sample_curves<true, false>(img, f, out);
 }
 void all_plain(const Image& img, float f, float* out) noexcept { sample_curves<false, false>(img, f, out); }
+KEYANIM_V3_TARGET void other_v3(const Image& img, float f, float* out) noexcept {
+  sample_curves<true, kWideAtV3, false>(img, f, out);
+}
+KEYANIM_POPCNT_TARGET void other_popcnt(const Image& img, float f, float* out) noexcept {
+  sample_curves<true, false, false>(img, f, out);
+}
+void other_plain(const Image& img, float f, float* out) noexcept { sample_curves<false, false, false>(img, f, out); }
 KEYANIM_V3_TARGET void listed_v3(const Image& img, float f, const uint32_t* ch, uint32_t n, float* out) noexcept {
   sample_chunks<true, kWideAtV3>(img, f, ch, n, out);
 }
@@ -469,6 +383,14 @@ void sample_all(const Image& img, float f, float* out) noexcept {
     case CpuLevel::v3: return all_v3(img, f, out);
     case CpuLevel::popcnt: return all_popcnt(img, f, out);
     default: return all_plain(img, f, out);
+  }
+}
+
+void sample_all_but_quat_tracks(const Image& img, float f, float* out) noexcept {
+  switch (cpu_level()) {
+    case CpuLevel::v3: return other_v3(img, f, out);
+    case CpuLevel::popcnt: return other_popcnt(img, f, out);
+    default: return other_plain(img, f, out);
   }
 }
 

@@ -10,6 +10,9 @@ namespace keyanim::internal {
 
 // Every channel at frame position f (not NaN): out[c] for c < channel count.
 void sample_all(const Image& img, float f, float* out) noexcept;
+// The same but the quaternion tracks' channels, left as they were: for a pose, which takes
+// those tracks' rotations from quat_track_rotations (quat_tracks.h).
+void sample_all_but_quat_tracks(const Image& img, float f, float* out) noexcept;
 // The listed channels (each < channel count): out[i] for channels[i].
 void sample_listed(const Image& img, float f, const uint32_t* channels, uint32_t count, float* out) noexcept;
 

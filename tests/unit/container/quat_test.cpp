@@ -153,6 +153,12 @@ TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its
                      r[3] * v[2] + r[0] * v[1] - r[1] * v[0] + r[2] * w, r[3] * w - r[0] * v[0] - r[1] * v[1] - r[2] * v[2]};
       const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
       for (double& k : q) k /= norm;
+      // The pose's binary32 arithmetic, whichever path (a track's or a curve's) computed it.
+      float ref32[4], q32[4];
+      keyanim::reference_of(qn, ref32);
+      keyanim::stored_rotation<float>(ref32, stored[c], stored[c + 1], stored[c + 2], q32,
+                                      [](float a) { return std::sqrt(a); }, [](float a) { return std::max(a, 0.0f); });
+      CHECK(std::memcmp(q32, local[qn.node].rotation, sizeof q32) == 0);
       const double got[4] = {local[qn.node].rotation[0], local[qn.node].rotation[1], local[qn.node].rotation[2],
                              local[qn.node].rotation[3]};
       worst_pose = std::max(worst_pose, angle_between(q, got));

@@ -1,0 +1,123 @@
+// The scalar pass of sampling (sampler.cpp, quat_tracks.cpp): where a position falls, and a
+// block's record read into its keys' frames and dequantized values. Internal to the runtime;
+// everything here has internal linkage, so that each file's copies compiled for a CPU level
+// (internal/cpu.h) stay its own.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#include "internal/cpu.h"
+#include "internal/simd.h"
+#include "runtime/image.h"
+
+namespace keyanim::internal {
+namespace {
+
+// Where position f falls: its block, and f relative to the block's start (exact: see below).
+struct Position {
+  float f;    // the position
+  float rel;  // f - block start, exact (Sterbenz: the start is 0, or >= 64 and > f / 2)
+  uint32_t block, t;
+};
+
+Position position(const Image& img, float f) noexcept {
+  Position p;
+  p.f = f;
+  if (img.block_count == 0) return {f, f, 0, 0};
+  // Outside the clip every curve is clamped, whatever block is read; NaN never reaches here.
+  const float end = static_cast<float>((img.block_count << kBlockShift) - 1);
+  const float clamped = std::min(std::max(f, 0.0f), end);
+  p.block = static_cast<uint32_t>(clamped) >> kBlockShift;
+  const float start = static_cast<float>(p.block << kBlockShift);
+  p.t = std::min(static_cast<uint32_t>(clamped - start), kBlockFrames - 1);
+  p.rel = f - start;
+  return p;
+}
+
+// q = q_base + base + value, dequantized as Appendix A says (binary64 product, one rounding).
+// double(q_base + base) + double(value) is exact (|q| <= 2^53), so two lanes at a time with
+// SSE2 give the very same values.
+#if KEYANIM_SSE2
+[[gnu::always_inline]] inline void dequantize4(__m128i v, int64_t low, double step, float* out) noexcept {
+  const __m128d lowd = _mm_set1_pd(static_cast<double>(low)), s = _mm_set1_pd(step);
+  const __m128d a = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(v), lowd), s);
+  const __m128d b = _mm_mul_pd(_mm_add_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(v, v)), lowd), s);
+  _mm_storeu_ps(out, _mm_movelh_ps(_mm_cvtpd_ps(a), _mm_cvtpd_ps(b)));
+}
+#endif
+
+[[gnu::always_inline]] inline void dequantize4(const uint8_t* rec, const Window& w, const Curve& cv, float* out) noexcept {
+  const int64_t low = cv.q_base + static_cast<int64_t>(w.base);
+  [[maybe_unused]] const uint32_t vw = w.value_bits;  // unused without SSE2
+#if KEYANIM_SSE2
+  if (vw <= 14) {  // the usual widths: the four values in one load, split in two 64-bit lanes
+    uint64_t x;
+    std::memcpy(&x, rec + (w.at >> 3), 8);
+    x >>= w.at & 7;  // 4 vw + 7 <= 63 bits
+    const __m128i m = _mm_set1_epi64x(static_cast<int64_t>((uint64_t(1) << vw) - 1));
+    const __m128i v = _mm_set_epi64x(static_cast<int64_t>(x >> (2 * vw)), static_cast<int64_t>(x));  // v0 v1 | v2 v3
+    const __m128i even = _mm_and_si128(v, m);                                        // v0, v2
+    const __m128i odd = _mm_and_si128(_mm_srl_epi64(v, _mm_cvtsi32_si128(static_cast<int>(vw))), m);  // v1, v3
+    dequantize4(_mm_or_si128(even, _mm_slli_epi64(odd, 32)), low, cv.step, out);
+    return;
+  }
+#endif
+  uint64_t value[4];
+  window_values(rec, w, value);
+#if KEYANIM_SSE2
+  if (vw <= 31) {
+    dequantize4(_mm_set_epi32(static_cast<int32_t>(value[3]), static_cast<int32_t>(value[2]),
+                              static_cast<int32_t>(value[1]), static_cast<int32_t>(value[0])),
+                low, cv.step, out);
+    return;
+  }
+#endif
+  for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(value[k]), cv.step);
+}
+
+// The image's arrays for one block, loaded once per pose rather than once per curve.
+struct BlockView {
+  const uint8_t* payload;
+  const uint32_t* offsets;  // the block's row of record offsets, one per track
+  const Curve* curves;
+  uint64_t upto;            // frames_upto(t): the block's keys at or before the position
+};
+
+BlockView block_view(const Image& img, const Position& at) noexcept {
+  return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_tracks, img.curves.data(),
+          frames_upto(at.t)};
+}
+
+// Quaternion track `track`'s curves x, y, z (their indices curve[0..2]): one search of the
+// shared mask gives every curve's window (their key frames are the same), into frame[0..4);
+// their Bases, then their Values, follow one another: curve k's four values into values[k]
+// (skipped where null).
+template <bool kPopcnt>
+[[gnu::always_inline]] inline void read_track(const BlockView& v, uint32_t track, const uint32_t (&curve)[3],
+                                              int32_t* frame, float* const (&values)[3]) noexcept {
+  const uint8_t* rec = v.payload + v.offsets[track];
+  uint64_t mask;
+  std::memcpy(&mask, rec, 8);
+  const uint32_t kw = rec[kTrackRecordBitsAt / 8 - 1];
+  Window w;
+  const uint32_t count = window_frames<kPopcnt>(rec, mask, kTrackRecordBitsAt / 8, kw, v.upto, frame);
+  const uint64_t n = popcount64<kPopcnt>(mask) + kContextKeys;  // values per curve
+  const Curve* cv[3] = {v.curves + curve[0], v.curves + curve[1], v.curves + curve[2]};
+  uint64_t base_at = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw;
+  uint64_t at = base_at + cv[0]->base_bits + cv[1]->base_bits + cv[2]->base_bits;
+  for (uint32_t k = 0; k < kTrackCurves; ++k) {
+    const uint32_t vw = rec[8 + k];
+    if (values[k] != nullptr) {
+      w.base = read_bits(rec, base_at, cv[k]->base_bits);
+      w.value_bits = vw;
+      w.at = at + uint64_t(count) * vw;
+      dequantize4(rec, w, *cv[k], values[k]);
+    }
+    base_at += cv[k]->base_bits;
+    at += n * vw;
+  }
+}
+
+}  // namespace
+}  // namespace keyanim::internal
