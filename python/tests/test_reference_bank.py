@@ -1,4 +1,4 @@
-"""spec/test-vectors/reference_decoder.py on banks (spec section 10, version 4.1).
+"""spec/test-vectors/reference_decoder.py on banks (spec section 10, versions 4.1 and 5.0).
 
 The banks are made here by BankWriter, a small writer written from section 10's text (a test
 helper, not shipped): it turns the existing test vectors into members (SKEL taken out, into
@@ -8,7 +8,9 @@ the member's own checksum recomputed) and lays out header, tables, name order, n
 dictionary, skeletons, Bank_Checksum and members as 10.1 says. Every clip must decode to the
 keys and the expected values (.json) of the standalone vector it came from; then one rule of
 section 10 at a time is broken and must be refused with its status, a member's failure naming
-the clip while the others still decode.
+the clip while the others still decode. Banks of version 5.0 hold members of version 5 (clips
+with quaternion nodes) beside members of version 4; a member of version 5 in a bank of version
+4 is refused.
 
 The dictionary case trains a zstd dictionary on the vectors' sections with the `zstd` program
 (`zstd --train`), and recompresses the members' compressed sections with it.
@@ -83,7 +85,7 @@ def with_checksum(body, runtime):
 _MEMBERS = {}
 
 
-def as_member(data, dictionary=None, minor=1, keep_skel=False):
+def as_member(data, dictionary=None, minor=None, keep_skel=False):
     """as_member_uncached, once per arguments (each zstd run is a process)."""
     key = (data, dictionary and Path(dictionary).read_bytes(), minor, keep_skel)
     if key not in _MEMBERS:
@@ -91,9 +93,10 @@ def as_member(data, dictionary=None, minor=1, keep_skel=False):
     return _MEMBERS[key]
 
 
-def as_member_uncached(data, dictionary=None, minor=1, keep_skel=False):
+def as_member_uncached(data, dictionary=None, minor=None, keep_skel=False):
     """(member bytes, skeleton, CLIP's Frame_Time, CLIP's Frame_Count) of clip file `data`
-    (10.5): version 4.`minor`, Member set, no SKEL (kept, to break 10.5.2, with keep_skel),
+    (10.5): version 4.`minor` (default 4.1), or 5.`minor` for a file of version 5 (default
+    5.0), Member set, no SKEL (kept, to break 10.5.2, with keep_skel),
     compressed sections recompressed with the bank's dictionary (a file) when there is one.
     skeleton: {raw: SKEL's content, stored: its bytes in the file, flags: Compressed or 0},
     stored in the bank as the file stores it (a zstd frame made without any dictionary)."""
@@ -110,7 +113,10 @@ def as_member_uncached(data, dictionary=None, minor=1, keep_skel=False):
             body = zstd(["-19", "-D", dictionary], plain)
         entries.append((tag, sflags, len(body), raw, body))
     clip = next(e[4] for e in entries if e[0] == b"CLIP")
-    head = SIGNATURE + struct.pack("<HHIII", 4, minor, flags | MEMBER, len(entries), 0)
+    major = 5 if struct.unpack_from("<H", data, 8)[0] >= 5 else 4
+    if minor is None:
+        minor = 1 if major == 4 else 0
+    head = SIGNATURE + struct.pack("<HHIII", major, minor, flags | MEMBER, len(entries), 0)
     table = b"".join(struct.pack("<4sIQQ", t, f, s, r) for t, f, s, r, _ in entries)
     member = with_checksum(head + table + b"".join(e[4] for e in entries), runtime)
     frame_count, = struct.unpack_from("<I", clip, 0)
@@ -145,11 +151,16 @@ class BankWriter:
             Path(self._dict_file).write_bytes(self.dictionary)
         return self._dict_file
 
-    def build(self, order=None, pool=None, name_at=None, flags=None, minor=1, clip_count=None, skeleton_count=None,
-              names_size=None, dictionary_size=None):
+    def build(self, order=None, pool=None, name_at=None, flags=None, major=None, minor=None, clip_count=None,
+              skeleton_count=None, names_size=None, dictionary_size=None):
         """The bank's bytes (10.1-10.4). order: the name order (default: the clips by name);
         pool, name_at: the name pool and each clip's Name_Offset (default: the names one after
-        the other)."""
+        the other); major, minor: the version (default 5.0 when a member is of version 5, else
+        4.1)."""
+        if major is None:
+            major = max([4] + [struct.unpack_from("<H", c["member"], 8)[0] for c in self.clips])
+        if minor is None:
+            minor = 1 if major == 4 else 0
         names = [c["name"] for c in self.clips]
         if pool is None:
             pool, name_at = b"".join(names), [sum(map(len, names[:i])) for i in range(len(names))]
@@ -174,7 +185,7 @@ class BankWriter:
             pos = member_at[-1] + len(c["member"])
         self.at["skeletons"], self.at["members"] = skel_at, member_at
         header = SIGNATURE + struct.pack(
-            "<HHIIIQQ", 4, minor, (BANK | (RUNTIME if self.runtime else 0)) if flags is None else flags,
+            "<HHIIIQQ", major, minor, (BANK | (RUNTIME if self.runtime else 0)) if flags is None else flags,
             n_clips if clip_count is None else clip_count, n_skel if skeleton_count is None else skeleton_count,
             len(pool) if names_size is None else names_size, len(dictionary) if dictionary_size is None else dictionary_size)
         out = bytearray(header)
@@ -297,7 +308,7 @@ def check_bank_decodes(w, data, clips):
     for i, (name, (src, expected_json)) in enumerate(clips.items()):
         assert rd.find_clip(bank, name) == i
         clip = rd.decode_member(bank, i)
-        assert clip["version"] == (4, 1)
+        assert clip["version"] == ((5, 0) if rd.parse(source(src))["version"][0] == 5 else (4, 1))
         compare_with_standalone(clip, src)
         if expected_json:
             text = rd.json_text(rd.expected_values(clip, "bank.kbank", name.decode()))
@@ -376,6 +387,98 @@ def test_a_member_of_minor_version_0_decodes():
     w = BankWriter()
     w.add(b"rules", vector("v3_rules.kanim"), minor=0)
     assert rd.decode_member(rd.open_bank(w.build()), 0)["version"] == (4, 0)
+
+
+# ---- Banks of version 5.0: members of version 5 beside members of version 4
+
+ARCHIVE_CLIPS_V5 = {
+    b"quat": ("v5_quat.kanim", "v5_quat.json"),
+    b"walk/rules": ("v3_rules.kanim", "v3_rules.json"),  # a member of version 4 (3.0's layout)
+    b"blocks/quat": ("v5_blocks.kanim", "v5_blocks.json"),
+    b"walk/rules v4": ("v4_archive.kanim", "v4_archive.json"),  # v3_rules' skeleton again
+}
+RUNTIME_CLIPS_V5 = {
+    b"quat": ("v5_quat_runtime.kanim", "v5_quat_runtime.json"),
+    b"rules": ("v4_rules.kanim", "v4_rules.json"),
+    b"blocks/quat": ("v5_blocks_runtime.kanim", "v5_blocks_runtime.json"),
+}
+
+
+@pytest.mark.parametrize("runtime", [False, True])
+def test_a_version_5_bank_decodes_each_clip_as_its_standalone_vector(runtime):
+    clips = RUNTIME_CLIPS_V5 if runtime else ARCHIVE_CLIPS_V5
+    w = make_bank(clips, runtime=runtime)
+    data = w.build()
+    assert struct.unpack_from("<HH", data, 8) == (5, 0) and rd.is_bank(data)
+    bank = check_bank_decodes(w, data, clips)
+    assert bank["version"] == (5, 0) and bank["runtime"] == runtime
+    quat = rd.decode_member(bank, 0)
+    assert [q["node"] for q in quat["quat_nodes"]] == [1, 2, 3, 5]
+
+
+def test_a_version_5_bank_of_version_4_members_only_decodes():
+    """A bank of version 5.0 may hold members of version 4 alone (10.5: a member's major version
+    at most its bank's)."""
+    w = make_bank({b"rules": ("v3_rules.kanim", "v3_rules.json")})
+    bank = rd.open_bank(w.build(major=5))
+    assert bank["version"] == (5, 0) and rd.decode_member(bank, 0)["version"] == (4, 1)
+
+
+def v5_member_change(change):
+    """Clip 0's member (v5_quat's) with its table changed by change([(tag, flags, stored, raw,
+    body)]) and its CRC-32 fixed."""
+    def make(c):
+        member = c["member"]
+        entries = table_of(member)
+        change(entries)
+        head = bytearray(member[:24])
+        struct.pack_into("<I", head, 16, len(entries))
+        table = b"".join(struct.pack("<4sIQQ", t, f, s, r) for t, f, s, r, _ in entries)
+        return with_checksum(bytes(head) + table + b"".join(e[4] for e in entries), False)
+    return make
+
+
+def drop_quat(entries):
+    entries.pop(next(i for i, x in enumerate(entries) if x[0] == b"QUAT"))
+
+
+def v5_bank(runtime=False, member=None, major=None):
+    """A bank of ARCHIVE_CLIPS_V5 (or RUNTIME_CLIPS_V5) with clip 0's member remade by
+    member(writer clip), and its header's Major_Version `major` (default: the writer's, 5)."""
+    def make():
+        w = make_bank(RUNTIME_CLIPS_V5 if runtime else ARCHIVE_CLIPS_V5, runtime=runtime)
+        if member:
+            w.clips[0]["member"] = member(w.clips[0])
+        return w, w.build(major=major)
+    return make
+
+
+V5_MEMBER_RULES = {
+    # (how, status, message); the member refused is clip 0, v5_quat's
+    "a member of version 5 in a bank of version 4": (v5_bank(major=4), "corrupt",
+                                                     "a member of version 5 in a bank of version 4"),
+    "a runtime member of version 5 in a bank of version 4": (v5_bank(runtime=True, major=4), "corrupt",
+                                                             "a member of version 5 in a bank of version 4"),
+    "a member of version 6": (v5_bank(member=lambda c: member_header(major=6)(c), major=5), "unsupported_version",
+                              "major 6"),
+    "a member of version 5 without QUAT": (v5_bank(member=v5_member_change(drop_quat)), "corrupt", "critical sections"),
+    "a member of version 5 with its SKEL": (v5_bank(member=lambda c: as_member(vector("v5_quat.kanim"), keep_skel=True)[0]),
+                                            "corrupt", "a SKEL section in a bank's member"),
+}
+
+
+@pytest.mark.parametrize("case", list(V5_MEMBER_RULES))
+def test_a_broken_version_5_member_is_refused_by_name(case):
+    """The member refused by name; the bank's other members of its version or below decode."""
+    make, status, message = V5_MEMBER_RULES[case]
+    w, data = make()
+    bank = rd.open_bank(data)
+    check_member_refused(w, data, 0, status, message, others_decode=False)
+    for i, c in enumerate(w.clips[1:], 1):
+        if struct.unpack_from("<H", c["member"], 8)[0] <= bank["version"][0]:
+            rd.decode_member(bank, i)
+        else:  # a bank of version 4: every member of version 5 is refused
+            check_member_refused(w, data, i, status, message, others_decode=False)
 
 
 # ---- The command line
@@ -467,7 +570,7 @@ OPEN_RULES = {
     # 10.2: the header
     "a bad signature": (lambda w, d: b"\x89KAM" + d[4:], "bad_signature", "signature"),
     "the header cut": (lambda w, d: d[:39], "truncated", "bank header"),
-    "Major_Version 5": (patch("H", lambda w: 8, 5), "unsupported_version", "major 5"),
+    "Major_Version 6": (patch("H", lambda w: 8, 6), "unsupported_version", "major 6"),
     "a reserved Header_Flags bit": (patch("I", lambda w: 12, BANK | 8), "reserved_bits_set", "Header_Flags bits 3-15"),
     "Member set in a bank": (patch("I", lambda w: 12, BANK | MEMBER), "corrupt", "Member bit is set"),
     "Runtime with a dictionary": (rebuilt(flags=BANK | RUNTIME, dictionary_size=8), "corrupt", "Dictionary_Size with Runtime"),
@@ -621,6 +724,7 @@ def test_a_bank_is_not_read_as_a_clip_file(archive):
         rd.parse(archive[1])
     assert e.value.status == "corrupt" and "Bank set" in str(e.value)
     assert rd.is_bank(archive[1]) and not rd.is_bank(vector("v4_rules.kanim"))
+    assert rd.is_bank(vector("b50_archive.kbank")) and not rd.is_bank(vector("v5_quat_runtime.kanim"))
 
 
 def test_a_member_by_itself_is_refused(archive):
@@ -853,3 +957,65 @@ def test_the_b41_vectors_decode_to_their_clips_vectors(name):
         clip = rd.decode_member(bank, c["index"])
         text = rd.json_text(rd.expected_values(clip, f"{name}.kbank", clip_name))
         assert json_less_names(text) == json_less_names((VECTORS / f"{clip_name}.json").read_text()), clip_name
+
+
+# ---- The b50_* vectors (keyanim pack, make_b50.sh): banks of version 5.0 whose members of
+# version 5 (v5_quat, v5_blocks) sit beside members of version 4 (v3_rules, v3_long); each clip
+# decodes to its vector's expected values, in both profiles.
+
+@pytest.mark.parametrize("name", ["b50_archive", "b50_runtime"])
+def test_the_b50_vectors_decode_to_their_clips_vectors(name):
+    bank = rd.open_bank(vector(f"{name}.kbank"))
+    assert bank["version"] == (5, 0) and bank["runtime"] == (name == "b50_runtime") and bank["dictionary"] is None
+    assert [c["name"] for c in bank["clips"]] == [b"v5_quat", b"v5_blocks", b"v3_rules", b"v3_long"]
+    versions = []
+    for c in bank["clips"]:
+        clip_name = c["name"].decode()
+        assert rd.find_clip(bank, c["name"]) == c["index"]
+        clip = rd.decode_member(bank, c["index"])
+        versions.append(clip["version"][0])
+        text = rd.json_text(rd.expected_values(clip, f"{name}.kbank", clip_name))
+        assert json_less_names(text) == json_less_names((VECTORS / f"{clip_name}.json").read_text()), clip_name
+    assert versions == [5, 5, 4, 4]
+
+
+def test_the_b50_vectors_are_what_keyanim_pack_writes():
+    """make_b50.sh with the tool: it checks the vectors that exist hold the bytes it makes."""
+    r = subprocess.run(["bash", str(VECTORS / "make_b50.sh"), tool()], capture_output=True, text=True)
+    assert r.returncode == 0 and "wrote" not in r.stdout, r.stdout + r.stderr
+
+
+def test_the_command_line_lists_a_version_5_bank():
+    r = run(VECTORS / "b50_runtime.kbank")
+    assert r.returncode == 0, r.stderr
+    index = json.loads(r.stdout)
+    assert index["format_version"] == "5.0" and index["profile"] == "runtime" and len(index["clips"]) == 4
+    r = run(VECTORS / "b50_archive.kbank", "v5_quat")
+    assert r.returncode == 0, r.stderr
+    assert json_less_names(r.stdout) == json_less_names((VECTORS / "v5_quat.json").read_text())
+
+
+@pytest.mark.parametrize("case", list(V5_MEMBER_RULES))
+def test_keyanim_refuses_the_broken_version_5_member_too(case, tmp_path):
+    make, status, _ = V5_MEMBER_RULES[case]
+    w, data = make()
+    path = tmp_path / "b.kbank"
+    path.write_bytes(data)
+    name = w.clips[0]["name"].decode()
+    code, found, err = tool_status(["convert", f"{path}:{name}", "--archive", "-o", tmp_path / "out.kanim"])
+    assert code != 0 and status in found and name in err, err
+    assert not (tmp_path / "out.kanim").exists()
+    other = w.clips[1]["name"].decode()  # a member of version 4: it converts
+    code, _, err = tool_status(["-q", "convert", f"{path}:{other}", "--archive", "-o", tmp_path / "other.kanim"])
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("runtime", [False, True])
+def test_keyanim_unpacks_a_version_5_bank_to_the_standalone_clips(runtime, tmp_path):
+    clips = RUNTIME_CLIPS_V5 if runtime else ARCHIVE_CLIPS_V5
+    bank = tmp_path / "b.kbank"
+    bank.write_bytes(make_bank(clips, runtime=runtime).build())
+    code, _, err = tool_status(["-q", "unpack", bank, "-o", tmp_path / "out"])
+    assert code == 0, err
+    for name, (src, _) in clips.items():
+        compare_with_standalone(rd.parse((tmp_path / "out" / (name.decode() + ".kanim")).read_bytes()), src)

@@ -1,7 +1,10 @@
-"""spec/test-vectors/reference_decoder.py on the runtime profile (spec section 9) and the v4
-vectors: its XXH64 against xxHash's check values, the v4 JSON against the v3 JSON of the same
-clip, and one rejection per rule of 9.1-9.4, each made by breaking that rule alone in a v4
-vector (the XXH64 fixed again, so that the rule and not the checksum refuses it).
+"""spec/test-vectors/reference_decoder.py on the runtime profile (spec section 9), the v4 vectors
+and version 5 (quaternion nodes, 4.7): its XXH64 against xxHash's check values, the v4 JSON
+against the v3 JSON of the same clip and the v5 runtime JSON against the v5 archive JSON, and one
+rejection per rule of 9.1-9.4 and of version 5 (4.3, 4.4, 4.7, 8, 9.2), each made by breaking
+that rule alone in a vector (the checksum fixed again, so that the rule and not the checksum
+refuses it). runtime_writer.py, a writer of the runtime profile from the spec's text, makes the
+runtime files no vector holds, and is checked to make the runtime vectors byte for byte.
 
 Where KEYANIM_CLI names the keyanim tool, every broken file is also given to
 `keyanim convert --archive`, which checks structure and content (C++, written apart from the
@@ -27,14 +30,15 @@ VECTORS = REPO / "spec" / "test-vectors"
 NAMES = ["rules", "uniform", "single", "long", "predict", "blocks"]
 
 
-def load_module(name):
-    spec = importlib.util.spec_from_file_location(name, VECTORS / f"{name}.py")
+def load_module(name, directory=VECTORS):
+    spec = importlib.util.spec_from_file_location(name, directory / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
 rd = load_module("reference_decoder")
+writer = load_module("runtime_writer", Path(__file__).resolve().parent)
 
 
 def vector(name):
@@ -95,8 +99,8 @@ def test_v4_keys_equal_v3_keys(v4, v3):
 @pytest.mark.parametrize("v4", [f"v4_{n}" for n in NAMES] + ["v4_archive"])
 def test_v4_json_is_what_the_reference_decoder_writes(v4, tmp_path):
     (tmp_path / f"{v4}.kanim").write_bytes(vector(f"{v4}.kanim"))
-    out = rd.write_json(str(tmp_path / f"{v4}.kanim"))
-    assert Path(out).read_bytes() == (VECTORS / f"{v4}.json").read_bytes()
+    out, what = rd.write_json(str(tmp_path / f"{v4}.kanim"))
+    assert what == "wrote" and Path(out).read_bytes() == (VECTORS / f"{v4}.json").read_bytes()
 
 
 def test_v4_archive_is_v3_rules_with_major_version_4():
@@ -110,10 +114,7 @@ def test_the_vectors_cover_the_image():
     """What the rejections below and Appendix C rely on: block and list curves, fixed
     channels, records without keys, the widest values, a NOTE."""
     def image(name):
-        data = vector(f"v4_{name}.kanim")
-        content = rd.runtime_sections(data, struct.unpack_from("<I", data, 16)[0])
-        F, N, C, rule, frame_time, K = rd.parse_clip(content["CLIP"])
-        return content, rd.parse_image(content["IMAG"], F, C, K)
+        return image_of(vector(f"v4_{name}.kanim"))
     _, rules = image("rules")
     assert rules["header"]["nb"] == 10 and rules["header"]["B"] == 1
     _, predict = image("predict")
@@ -126,6 +127,15 @@ def test_the_vectors_cover_the_image():
     assert "NOTE" in content and single["header"]["nc"] == 0
 
 
+def image_of(data):
+    """(sections, parsed IMAG) of a valid runtime-profile file."""
+    major = struct.unpack_from("<H", data, 8)[0]
+    content = rd.runtime_sections(data, struct.unpack_from("<I", data, 16)[0], major)
+    F, N, C, rule, frame_time, K = rd.parse_clip(content["CLIP"])
+    nodes = rd.parse_skel(content["SKEL"], N, C)
+    return content, rd.parse_image(content["IMAG"], F, C, K, major, nodes if major >= 5 else None)
+
+
 # ---- Breaking one rule at a time
 
 class Runtime:
@@ -133,6 +143,7 @@ class Runtime:
 
     def __init__(self, data):
         self.b = bytearray(data)
+        self.major = struct.unpack_from("<H", self.b, 8)[0]
         self.count = struct.unpack_from("<I", self.b, 16)[0]
         self.entries = [struct.unpack_from("<4sIQQ", self.b, 24 + 24 * i) for i in range(self.count)]
         self.at, pos = {}, 24 + 24 * self.count
@@ -140,9 +151,10 @@ class Runtime:
             self.at[tag.decode()] = pos
             pos += stored
         clip = self.at["CLIP"]
-        self.F, _, self.C = struct.unpack_from("<III", self.b, clip)
+        self.F, self.N, self.C = struct.unpack_from("<III", self.b, clip)
         imag = self.at["IMAG"]
-        self.h = rd.image_header(bytes(self.b[imag:imag + 32]), self.F, self.C)
+        self.h = rd.image_header(bytes(self.b[imag:imag + 32]), self.F, self.C, self.N, self.major)
+        self.tracks = image_of(data)[1]["tracks"]  # each block track's curves (9.2)
         self.array, pos = {}, imag + 32
         for name, fmt, n in rd.image_array_specs(self.h):
             self.array[name] = pos
@@ -158,12 +170,17 @@ class Runtime:
         return self.array[name] + size * i
 
     def record(self, idx):
-        """Byte offset in the file of record idx (block-major), and its fields' widths."""
+        """Byte offset in the file of record idx (block-major), and its fields' widths: of a
+        track of one curve (w, wc) or three (ws, wcs; w, wc their sums), the bits before its
+        Context (head)."""
         at = self.array["Payload"] + self.get("I", self.entry("Record_Offset", idx, 4))
-        curve = idx % self.h["nb"]
-        wc = self.get("I", self.entry("Curves", curve, 24) + 16)
-        mask, w, wk = struct.unpack_from("<QBB", self.b, at)
-        return at, {"m": bin(mask).count("1"), "w": w, "wk": wk, "wc": wc}
+        curves = self.tracks[idx % self.h["nt"]]
+        wcs = [self.get("I", self.entry("Curves", i, 24) + 16) for i in curves]
+        mask = self.get("Q", at)
+        ws = list(self.b[at + 8:at + 8 + len(curves)])
+        wk = self.b[at + 8 + len(curves)]
+        return at, {"m": bin(mask).count("1"), "w": sum(ws), "wk": wk, "wc": sum(wcs), "ws": ws, "wcs": wcs,
+                    "head": 72 + 8 * len(curves), "curves": curves}
 
     def record_field(self, idx, bit, width, value=None):
         """Reads (or writes) the bit field of record idx at `bit`, `width` bits wide (9.3)."""
@@ -251,20 +268,21 @@ def first_channel(r, n):
     return next(c for c in range(r.C) if r.get("I", r.entry("Key_Count", c, 4)) == n)
 
 
-def set_record_bits_after_fields(r):
-    """Sets a bit after the last field of the first record whose bits do not fill its bytes."""
+def set_record_bits_after_fields(r, tracks_of=1):
+    """Sets a bit after the last field of the first record (of a track of tracks_of curves)
+    whose bits do not fill its bytes."""
     for idx in range(r.h["R"]):
         _, f = r.record(idx)
-        nbits = 80 + 4 * f["wk"] + f["wc"] + (f["m"] + 4) * f["w"]
-        if nbits % 8:
+        nbits = f["head"] + 4 * f["wk"] + f["wc"] + (f["m"] + 4) * f["w"]
+        if len(f["curves"]) == tracks_of and nbits % 8:
             r.record_field(idx, nbits, 1, 1)
             return
     raise AssertionError("every record of the vector fills its bytes")
 
 
-def swap_context_0_into_1(r):
-    _, f = r.record(0)
-    r.record_field(0, 80 + f["wk"], f["wk"], r.record_field(0, 80, f["wk"]))  # e_1 = e_0
+def swap_context_0_into_1(r, idx=0):
+    _, f = r.record(idx)
+    r.record_field(idx, f["head"] + f["wk"], f["wk"], r.record_field(idx, f["head"], f["wk"]))  # e_1 = e_0
 
 
 def popcount_against_key_count(r):
@@ -358,11 +376,6 @@ for _name, (_make, _message) in PREDICT_LISTS.items():
     STRUCTURE[_name] = ((lambda make: lambda: mutate(make)("v4_predict.kanim"))(_make), "corrupt", _message)
 
 
-# Cases where keyanim (C++) is known to differ from this decoder (strict: the mark must go when
-# the tool changes). None today.
-CPP_DIFFERS = {}
-
-
 def cli_refuses(data, status, tmp_path):
     """The C++ tool (KEYANIM_CLI) refuses the same file with the same status."""
     tool = os.environ.get("KEYANIM_CLI")
@@ -386,28 +399,37 @@ def test_a_broken_structure_rule_is_refused(case, tmp_path):
     assert message in str(e.value)
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(strict=True, reason=CPP_DIFFERS[c]))
-                                  if c in CPP_DIFFERS else c for c in STRUCTURE])
+@pytest.mark.parametrize("case", list(STRUCTURE))
 def test_keyanim_refuses_the_broken_structure_too(case, tmp_path):
     make, status, _ = STRUCTURE[case]
     cli_refuses(make(), status, tmp_path)
 
 
-def change_value_field(r, idx, field):
-    """Adds 1 (or takes 1) to value field `field` of record idx, within its width."""
+def change_value_field(r, idx, field, curve=0):
+    """Adds 1 (or takes 1) to value field `field` of record idx, of its curve `curve` (0, 1, 2
+    in a track of three), within its width."""
     _, f = r.record(idx)
-    bit = 80 + 4 * f["wk"] + f["wc"] + field * f["w"]
-    old = r.record_field(idx, bit, f["w"])
-    r.record_field(idx, bit, f["w"], old + 1 if old + 1 < 1 << f["w"] else old - 1)
+    bit = f["head"] + 4 * f["wk"] + f["wc"] + (f["m"] + 4) * sum(f["ws"][:curve]) + field * f["ws"][curve]
+    width = f["ws"][curve]
+    old = r.record_field(idx, bit, width)
+    r.record_field(idx, bit, width, old + 1 if old + 1 < 1 << width else old - 1)
+
+
+def change_base(r, idx, curve):
+    """Adds 1 (or takes 1) to the Base of curve `curve` of record idx, within its width."""
+    _, f = r.record(idx)
+    bit, width = f["head"] + 4 * f["wk"] + sum(f["wcs"][:curve]), f["wcs"][curve]
+    old = r.record_field(idx, bit, width)
+    r.record_field(idx, bit, width, old + 1 if old + 1 < 1 << width else old - 1)
 
 
 def change_context_within_order(r):
     """Moves e_0 of record 0 one frame earlier (still before e_1, within Context_Bits)."""
     _, f = r.record(0)
-    old = rd.unzigzag(r.record_field(0, 80, f["wk"]))
+    old = rd.unzigzag(r.record_field(0, f["head"], f["wk"]))
     new = rd.zigzag(old - 1)
     assert new < 1 << f["wk"]
-    r.record_field(0, 80, f["wk"], new)
+    r.record_field(0, f["head"], f["wk"], new)
 
 
 def raise_the_lowest_block(r):
@@ -418,7 +440,7 @@ def raise_the_lowest_block(r):
         for b in range(r.h["B"]):
             idx = b * r.h["nb"] + curve
             _, f = r.record(idx)
-            base_at = 80 + 4 * f["wk"]
+            base_at = f["head"] + 4 * f["wk"]
             base = r.record_field(idx, base_at, f["wc"])
             keys = [r.record_field(idx, base_at + f["wc"] + j * f["w"], f["w"]) for j in range(2, f["m"] + 2)]
             if keys:
@@ -475,20 +497,27 @@ def test_what_9_1_allows_is_accepted():
         assert like == "v3_rules" or clip["notes"].startswith("encoder=")
 
 
-@pytest.mark.parametrize("bvh", ["cmu_02_01_walk.bvh", "cmu_131_03_hop.bvh"])
-def test_keyanim_runtime_files_of_real_clips_pass_every_check(bvh, tmp_path):
+@pytest.mark.parametrize("bvh,rotations", [("cmu_02_01_walk.bvh", "euler"), ("cmu_131_03_hop.bvh", "euler"),
+                                           ("cmu_02_01_walk.bvh", "quaternion"), ("cmu_131_03_hop.bvh", "quaternion")])
+def test_keyanim_runtime_files_of_real_clips_pass_every_check(bvh, rotations, tmp_path):
     """The shipped clips, encoded and converted by the tool: the runtime file passes the content
     checks too and holds the archive file's keys, value bits included (hop has records with a
-    Value_Bits of 0, which no vector has)."""
+    Value_Bits of 0, which no vector has). With Euler angles the files are of versions 3 and 4;
+    with quaternion nodes (the encoder's default) of version 5, the runtime file's quaternion
+    tracks laid out as 9.2 says."""
     tool = os.environ.get("KEYANIM_CLI")
     if not tool or not os.path.exists(tool):
         pytest.skip("the keyanim tool is not built (KEYANIM_CLI)")
     archive, runtime = tmp_path / "a.kanim", tmp_path / "r.kanim"
-    subprocess.run([tool, "-q", "encode", str(REPO / "data" / bvh), "-o", str(archive), "--error", "0.5%"], check=True)
+    subprocess.run([tool, "-q", "encode", str(REPO / "data" / bvh), "-o", str(archive), "--error", "0.5%",
+                    "--rotations", rotations], check=True)
     subprocess.run([tool, "-q", "convert", str(archive), "--runtime", "-o", str(runtime)], check=True)
     a, r = rd.parse(archive.read_bytes()), rd.parse(runtime.read_bytes())
-    assert r["version"] == (4, 0) and a["frames"] == r["frames"]
+    major = 5 if rotations == "quaternion" else 4
+    assert a["version"][0] == (5 if major == 5 else 3) and r["version"] == (major, 0) and a["frames"] == r["frames"]
     assert [[rd.f32_bits(v) for v in c] for c in a["values"]] == [[rd.f32_bits(v) for v in c] for c in r["values"]]
+    assert a["quat_nodes"] == r["quat_nodes"] and (len(a["quat_nodes"]) > 0) == (major == 5)
+    assert writer.runtime_file(archive.read_bytes()) == runtime.read_bytes()  # the spec's image, byte for byte
 
 
 def test_runtime_clear_reads_a_runtime_layout_as_an_archive_file_and_refuses_it():
@@ -499,10 +528,542 @@ def test_runtime_clear_reads_a_runtime_layout_as_an_archive_file_and_refuses_it(
 
 def test_an_unknown_major_version_is_refused():
     b = bytearray(vector("v4_rules.kanim"))
-    struct.pack_into("<H", b, 8, 5)
+    struct.pack_into("<H", b, 8, 6)
     with pytest.raises(rd.KanimError) as e:
         rd.parse(bytes(b))
-    assert e.value.status == "unsupported_version"
+    assert e.value.status == "unsupported_version" and "major 6" in str(e.value)
+
+
+# ---- Version 5: quaternion nodes (4.7) in both profiles
+
+V5 = ["v5_quat", "v5_blocks", "v5_quat_runtime", "v5_blocks_runtime"]
+
+
+@pytest.mark.parametrize("name", V5)
+def test_v5_json_is_what_the_reference_decoder_writes(name, tmp_path):
+    (tmp_path / f"{name}.kanim").write_bytes(vector(f"{name}.kanim"))
+    out, what = rd.write_json(str(tmp_path / f"{name}.kanim"))
+    assert what == "wrote" and Path(out).read_bytes() == (VECTORS / f"{name}.json").read_bytes()
+    assert rd.write_json(str(tmp_path / f"{name}.kanim")) == (out, "unchanged")  # left as it is
+
+
+def test_write_json_does_not_overwrite_other_values(tmp_path):
+    """A published vector's values never change (Appendix C): other bytes are an error."""
+    (tmp_path / "v5_quat.kanim").write_bytes(vector("v5_quat.kanim"))
+    (tmp_path / "v5_quat.json").write_text("{}\n")
+    with pytest.raises(rd.KanimError) as e:
+        rd.write_json(str(tmp_path / "v5_quat.kanim"))
+    assert e.value.status == "json_differs" and (tmp_path / "v5_quat.json").read_text() == "{}\n"
+
+
+def test_only_version_5_json_has_quaternion_fields():
+    for name in ["v3_rules", "v4_rules", "v4_archive"]:
+        d = json.loads((VECTORS / f"{name}.json").read_text())
+        assert "quat_nodes" not in d and all("rotations" not in x for x in d["samples"]), name
+    for name in V5:
+        d = json.loads((VECTORS / f"{name}.json").read_text())
+        assert d["format_version"] == "5.0" and d["quat_nodes"], name
+        assert all(len(x["rotations"]) == len(d["quat_nodes"]) for x in d["samples"]), name
+
+
+@pytest.mark.parametrize("name", ["v5_quat", "v5_blocks"])
+def test_v5_runtime_json_equals_archive_json(name):
+    """The runtime profile holds the same clip: the same JSON, less the fields naming the file."""
+    version_r, text_r = json_without_name(VECTORS / f"{name}_runtime.json")
+    version_a, text_a = json_without_name(VECTORS / f"{name}.json")
+    assert version_r == version_a == "5.0" and text_r == text_a
+
+
+@pytest.mark.parametrize("name", ["v5_quat", "v5_blocks"])
+def test_v5_runtime_keys_equal_archive_keys(name):
+    a, r = rd.parse(vector(f"{name}.kanim")), rd.parse(vector(f"{name}_runtime.kanim"))
+    assert a["version"] == r["version"] == (5, 0)
+    bits = lambda vs: [[rd.f32_bits(v) for v in c] for c in vs]
+    for key in ["frame_count", "frame_time", "tangent_rule", "nodes", "interp", "frames", "notes", "quat_nodes"]:
+        assert a[key] == r[key], key
+    assert bits(a["values"]) == bits(r["values"])
+
+
+@pytest.mark.parametrize("source,made", [(f"v3_{n}", f"v4_{n}") for n in NAMES] +
+                         [("v5_quat", "v5_quat_runtime"), ("v5_blocks", "v5_blocks_runtime")])
+def test_the_runtime_writer_makes_the_runtime_vectors(source, made):
+    """runtime_writer.py (9.2, 9.3 from the text) and keyanim write the same bytes: for version 5,
+    the quaternion tracks' curves component-major, their nodes first in Quat_Node, the records
+    of three curves."""
+    assert writer.runtime_file(vector(f"{source}.kanim")) == vector(f"{made}.kanim")
+
+
+def test_the_v5_vectors_cover_the_quaternion_rules():
+    """What the rejections below rely on."""
+    quat = rd.parse(vector("v5_quat.kanim"))
+    assert [q["node"] for q in quat["quat_nodes"]] == [1, 2, 3, 5]
+    assert [len(quat["frames"][q["column"]]) for q in quat["quat_nodes"]] == [81, 5, 1, 0]  # tracks, fixed, zero
+    assert quat["nodes"][6]["channels"][1] == "Xposition" and len(quat["nodes"][7]["channels"]) == 2
+    # A stored x that is a Zrotation channel: x, y, z are the rotation channels in their order.
+    assert quat["nodes"][1]["channels"] == ["Zrotation", "Xrotation", "Yrotation"]
+    _, image = image_of(vector("v5_quat_runtime.kanim"))
+    assert image["header"]["T"] == 2 and image["tracks"][:2] == [[0, 2, 4], [1, 3, 5]]
+    _, image = image_of(vector("v5_blocks_runtime.kanim"))
+    assert image["header"]["T"] == 1 and image["header"]["Q"] == 2 and image["header"]["LQ"] == 4  # padding lanes
+    assert image["arrays"]["Curve_Of"][7:10] == [7, 8, 9]  # node 2's x, y, z: list curves
+
+
+def swap_the_quaternion_nodes_keys(clip):
+    """v5_blocks with the keys of node 1's x, y, z (channels 4-6, block curves) and node 2's
+    (channels 7-9, list curves) exchanged: node 2 becomes the quaternion track, node 1 not."""
+    for key in ["frames", "q", "values", "step", "interp", "tension"]:
+        clip[key][4:7], clip[key][7:10] = clip[key][7:10], clip[key][4:7]
+
+
+def test_a_quaternion_track_after_a_node_without_one():
+    """9.2: Quat_Node lists the quaternion tracks' nodes first, whatever their index: here
+    [2, 1]. The decoder reads the file to the clip it was made from, its quaternion nodes in
+    node order (as QUAT lists them)."""
+    clip = rd.parse(vector("v5_blocks.kanim"))
+    swap_the_quaternion_nodes_keys(clip)
+    data = writer.runtime_file(vector("v5_blocks.kanim"), clip_change=swap_the_quaternion_nodes_keys)
+    content, image = image_of(data)
+    assert image["arrays"]["Quat_Node"] == [2, 1] and image["header"]["T"] == 1
+    assert image["arrays"]["Curve_Channel"][:4] == [7, 8, 9, 0]  # the track's x, y, z, then channel 0
+    r = rd.parse(data)
+    assert r["frames"] == clip["frames"] and r["values"] == clip["values"]
+    assert [q["node"] for q in r["quat_nodes"]] == [1, 2]
+    # In node order, Quat_Node would break 9.2's order.
+    bad = writer.runtime_file(vector("v5_blocks.kanim"), clip_change=swap_the_quaternion_nodes_keys,
+                              change=lambda header, a: swap_lanes_0_and_1(a))
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(bad)
+    assert e.value.status == "corrupt" and "has no block curves before a node with" in str(e.value), str(e.value)
+
+
+def swap_lanes_0_and_1(a):
+    """Quaternion nodes 0 and 1 of an image's parts exchanged in Quat_Node, Quat_Column and
+    Quat_Reference (four arrays of 4 lanes here)."""
+    for name in ["Quat_Node", "Quat_Column"]:
+        a[name][0], a[name][1] = a[name][1], a[name][0]
+    lanes = a["Quat_Reference"]
+    for k in range(4):
+        lanes[4 * k], lanes[4 * k + 1] = lanes[4 * k + 1], lanes[4 * k]
+
+
+def test_keyanim_reads_a_quaternion_track_after_a_node_without_one(tmp_path):
+    """The same file given to keyanim: it converts it to an archive file of the same clip."""
+    tool = os.environ.get("KEYANIM_CLI")
+    if not tool or not os.path.exists(tool):
+        pytest.skip("the keyanim tool is not built (KEYANIM_CLI)")
+    path, out = tmp_path / "r.kanim", tmp_path / "a.kanim"
+    path.write_bytes(writer.runtime_file(vector("v5_blocks.kanim"), clip_change=swap_the_quaternion_nodes_keys))
+    r = subprocess.run([tool, "-q", "convert", str(path), "--archive", "-o", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    a, want = rd.parse(out.read_bytes()), rd.parse(path.read_bytes())
+    assert a["version"] == (5, 0) and a["frames"] == want["frames"] and a["values"] == want["values"]
+    assert a["quat_nodes"] == want["quat_nodes"]
+
+
+def test_the_hamilton_product_is_r_times_s():
+    """4.7: q = r s. Rz(90 deg) Rx(90 deg) takes x to y, y to z, z to x: (1/2, 1/2, 1/2, 1/2);
+    s r would be (1/2, -1/2, 1/2, 1/2)."""
+    h = 0.5 ** 0.5
+    assert [round(x, 12) for x in rd.hamilton((0, 0, h, h), (h, 0, 0, h))] == [0.5, 0.5, 0.5, 0.5]
+    assert rd.quat_rotation([0, 0, 23170], h, 0, 0) == pytest.approx([0.5, 0.5, 0.5, 0.5], abs=3e-5)  # r of int16s
+
+
+def test_the_rotations_of_the_json_are_the_stored_values_under_the_reference():
+    """An identity reference: the rotation is (sx, sy, sz, w) itself; a reference r: r s, unit."""
+    d = json.loads((VECTORS / "v5_quat.json").read_text())
+    quats = rd.parse(vector("v5_quat.kanim"))["quat_nodes"]
+    assert d["quat_nodes"] == [{"node": q["node"], "reference": q["reference"]} for q in quats]
+    for sample in d["samples"]:
+        sx, sy, sz = sample["values"][6:9]  # node 1, reference (0, 0, 0)
+        w = max(0.0, 1 - (sx * sx + sy * sy + sz * sz)) ** 0.5
+        norm = (sx * sx + sy * sy + sz * sz + w * w) ** 0.5
+        assert sample["rotations"][0] == pytest.approx([sx / norm, sy / norm, sz / norm, w / norm], abs=1e-15)
+        for rotation in sample["rotations"]:
+            assert sum(x * x for x in rotation) == pytest.approx(1.0, abs=1e-14)
+    # Node 5 has no keys: its rotation is its reference's.
+    X, Y, Z = quats[3]["reference"]
+    r = [X / 32768, Y / 32768, Z / 32768, (1 - (X * X + Y * Y + Z * Z) / 2 ** 30) ** 0.5]
+    assert d["samples"][0]["rotations"][3] == pytest.approx(r, abs=1e-15)
+
+
+# -- The archive profile of version 5: QUAT, CHAN's rule, KTIM's shared key frames, section 8
+
+def archive_parts(data):
+    """[[tag, flags, content]] of an archive-profile file's sections, decompressed (Compressed
+    cleared), in table order."""
+    count = struct.unpack_from("<I", data, 16)[0]
+    out, pos = [], 24 + 24 * count
+    for i in range(count):
+        tag, flags, stored, raw = struct.unpack_from("<4sIQQ", data, 24 + 24 * i)
+        body = data[pos:pos + stored]
+        out.append([tag.decode(), flags & ~1, bytearray(rd.zstd_decompress(body) if flags & 1 else body)])
+        pos += stored
+    return out
+
+
+def archive_file(parts, like):
+    """An archive-profile file of these sections, uncompressed (any section MAY be, 3.2.5),
+    with the header of file `like` and its CRC-32 fixed."""
+    head = bytearray(like[:24])
+    struct.pack_into("<I", head, 16, len(parts))
+    table = b"".join(struct.pack("<4sIQQ", tag.encode(), flags, len(body), len(body)) for tag, flags, body in parts)
+    body = bytes(head) + table + b"".join(bytes(p[2]) for p in parts)
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+def part(parts, tag):
+    return next(p[2] for p in parts if p[0] == tag)
+
+
+def archive_change(change, name="v5_quat.kanim"):
+    """Vector `name` uncompressed, its sections changed by change(parts) (in place)."""
+    def build():
+        parts = archive_parts(vector(name))
+        change(parts)
+        return archive_file(parts, vector(name))
+    return build
+
+
+def quat_entry(j, node=None, reference=None):
+    def change(parts):
+        quat = part(parts, "QUAT")
+        if node is not None:
+            struct.pack_into("<I", quat, 4 + 10 * j, node)
+        if reference is not None:
+            struct.pack_into("<3h", quat, 8 + 10 * j, *reference)
+    return change
+
+
+def channel_types_at(skel, node):
+    """Offset in SKEL's content (4.2) of node `node`'s Channel_Types."""
+    pos = 0
+    for _ in range(node):
+        pos += 4 + struct.unpack_from("<I", skel, pos)[0] + 29
+        pos += 1 + skel[pos]
+    return pos + 4 + struct.unpack_from("<I", skel, pos)[0] + 30
+
+
+def neck_about_two_axes(skel):
+    """Node 5 (Neck: Zrotation, Xrotation, Yrotation) made Zrotation, Xrotation, Xrotation."""
+    at = channel_types_at(skel, 5)
+    assert list(skel[at:at + 3]) == [5, 3, 4]
+    skel[at + 2] = 3
+
+
+def swap_quat_entries(parts):
+    quat = part(parts, "QUAT")
+    quat[4:24] = quat[14:24] + quat[4:14]
+
+
+def chan_field(offset_of, fmt, value):
+    """CHAN's entry at offset_of(C) set to value(old)."""
+    def change(parts):
+        chan = part(parts, "CHAN")
+        C = len(chan) // 19
+        at = offset_of(C)
+        struct.pack_into("<" + fmt, chan, at, value(struct.unpack_from("<" + fmt, chan, at)[0]))
+    return change
+
+
+def varint(v):
+    out = bytearray()
+    while True:
+        out.append(v & 0x7F | (0x80 if v > 0x7F else 0))
+        v >>= 7
+        if not out[-1] & 0x80:
+            return bytes(out)
+
+
+def ktim_of_every_channel(parts):
+    """KTIM as a version 3 file would hold it: varints for every channel, a quaternion node's y and
+    z too (K varints instead of T)."""
+    clip = rd.parse(vector("v5_quat.kanim"))
+    out = b""
+    for k in clip["frames"]:
+        out += b"".join(varint(x if i == 0 else x - k[i - 1] - 1) for i, x in enumerate(k))
+    part(parts, "KTIM")[:] = out
+
+
+def move_quat_after_chan(parts):
+    i = next(i for i, p in enumerate(parts) if p[0] == "QUAT")
+    quat = parts.pop(i)
+    parts.insert(next(i for i, p in enumerate(parts) if p[0] == "CHAN") + 1, quat)
+
+
+def clip_counts(frames, keys, name="v5_quat.kanim"):
+    """Vector `name` (its bytes as they are: CLIP is stored uncompressed) with CLIP's
+    Frame_Count and Key_Count set to frames, keys(file size), CRC-32 fixed."""
+    def build():
+        b = bytearray(vector(name))
+        count = struct.unpack_from("<I", b, 16)[0]
+        assert b[24:28] == b"CLIP" and not struct.unpack_from("<I", b, 28)[0] & 1
+        at = 24 + 24 * count
+        struct.pack_into("<I", b, at, frames)
+        struct.pack_into("<Q", b, at + 24, keys(len(b)))
+        struct.pack_into("<I", b, len(b) - 4, zlib.crc32(bytes(b[:-4])))
+        return bytes(b)
+    return build
+
+
+def with_quat_section(name, flags):
+    """Vector `name` (version 3 or 4) with a QUAT section after SKEL."""
+    def change(parts):
+        parts.insert(2, ["QUAT", flags, bytearray(4)])
+    return archive_change(change, name)
+
+
+V5_ARCHIVE = {
+    # 4.7: QUAT (v5_quat: nodes 1, 2, 3, 5; node 6 has Zrotation, Xposition, Xrotation, Yrotation,
+    # node 7 two rotation channels, N = 9)
+    "QUAT: a node whose rotation channels are not consecutive": (
+        archive_change(quat_entry(3, node=6)), "corrupt", "are not three consecutive rotation channels"),
+    "QUAT: a node with two rotation channels": (
+        archive_change(quat_entry(3, node=7)), "corrupt", "are not three consecutive rotation channels"),
+    "QUAT: a node with no rotation channel": (
+        archive_change(quat_entry(3, node=8)), "corrupt", "are not three consecutive rotation channels"),
+    "QUAT: a node with three rotation channels about two axes": (
+        archive_change(lambda p: neck_about_two_axes(part(p, "SKEL"))), "corrupt", "are not three consecutive rotation channels"),
+    "QUAT: nodes not increasing": (archive_change(swap_quat_entries), "corrupt", "not above the entry before"),
+    "QUAT: Node = Node_Count": (archive_change(quat_entry(3, node=9)), "corrupt", "not < Node_Count 9"),
+    "QUAT: a reference beyond the unit ball": (
+        archive_change(quat_entry(1, reference=(32767, 32767, 0))), "corrupt", "X^2 + Y^2 + Z^2 > 2^30"),
+    "QUAT: a reference just beyond the unit ball": (
+        archive_change(quat_entry(1, reference=(-32768, 1, 0))), "corrupt", "X^2 + Y^2 + Z^2 > 2^30"),
+    "QUAT: Raw_Size 4 + 10 Q + 2": (archive_change(lambda p: part(p, "QUAT").extend(b"\0\0")), "corrupt",
+                                   "!= 4 + 10 x Quat_Count"),
+    "QUAT: Quat_Count > Node_Count": (archive_change(lambda p: struct.pack_into("<I", part(p, "QUAT"), 0, 10)),
+                                      "corrupt", "Quat_Count 10 > Node_Count 9"),
+    # 3.2.3: QUAT between SKEL and CHAN, once, critical; unknown before version 5
+    "no QUAT in version 5": (archive_change(lambda p: p.remove(next(x for x in p if x[0] == "QUAT"))), "corrupt",
+                             "critical sections"),
+    "QUAT after CHAN": (archive_change(move_quat_after_chan), "corrupt", "critical sections"),
+    "QUAT ancillary": (archive_change(lambda p: next(x for x in p if x[0] == "QUAT").__setitem__(1, 2)), "corrupt",
+                       "QUAT marked ancillary"),
+    "a critical QUAT in a version 3 file": (with_quat_section("v3_rules.kanim", 0), "reserved_bits_set",
+                                            "unknown critical section QUAT"),
+    "a critical QUAT in a version 4 archive file": (with_quat_section("v4_archive.kanim", 0), "reserved_bits_set",
+                                                   "unknown critical section QUAT"),
+    # 4.3: a quaternion node's x, y, z (node 1: channels 6, 7, 8) share Interpolation, Tension, Key_Count
+    "CHAN: y's Key_Count unlike x's": (archive_change(chan_field(lambda C: 13 * C + 4 * 7, "I", lambda v: v + 1)),
+                                      "corrupt", "channel 7's Interpolation, Tension or Key_Count"),
+    "CHAN: z's Tension one bit from x's": (archive_change(chan_field(lambda C: C + 4 * 8, "I", lambda v: v ^ 1)),
+                                          "corrupt", "channel 8's Interpolation, Tension or Key_Count"),
+    "CHAN: y's Interpolation unlike x's": (archive_change(chan_field(lambda C: 7, "B", lambda v: v ^ 1)),
+                                          "corrupt", "channel 7's Interpolation, Tension or Key_Count"),
+    # 4.4: no varints for a quaternion node's y and z (read as the next channels' key frames,
+    # they put a frame past Frame_Count or leave varints over)
+    "KTIM with varints for y and z": (archive_change(ktim_of_every_channel), "corrupt", ("key frame", "KTIM size")),
+    # 8: K at most 98304 x the file's size in version 5
+    "Key_Count > 98304 x the file's size": (clip_counts(2 ** 24, lambda size: 98304 * size + 1), "corrupt",
+                                            "98304 x the file's"),
+}
+
+
+@pytest.mark.parametrize("case", list(V5_ARCHIVE))
+def test_a_broken_version_5_archive_rule_is_refused(case):
+    make, status, message = V5_ARCHIVE[case]
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(make())
+    assert e.value.status == status, str(e.value)
+    assert any(m in str(e.value) for m in (message if isinstance(message, tuple) else (message,))), str(e.value)
+
+
+@pytest.mark.parametrize("case", list(V5_ARCHIVE))
+def test_keyanim_refuses_the_broken_version_5_archive_too(case, tmp_path):
+    make, status, _ = V5_ARCHIVE[case]
+    cli_refuses(make(), status, tmp_path)
+
+
+def test_the_uncompressed_v5_archive_decodes_as_the_vector():
+    """What the cases above start from: the vector, its sections stored uncompressed."""
+    a, b = rd.parse(archive_change(lambda parts: None)()), rd.parse(vector("v5_quat.kanim"))
+    assert a["values"] == b["values"] and a["frames"] == b["frames"] and a["quat_nodes"] == b["quat_nodes"]
+
+
+def test_what_version_5_allows_in_the_archive_profile_is_accepted():
+    """A reference on the unit sphere (X^2 + Y^2 + Z^2 = 2^30: rw = 0), an ancillary QUAT before
+    version 5 (an unknown ancillary section, skipped), and a Key_Count above 32768 but within
+    98304 times the file's size (refused by CHAN's sum, not by section 8's bound)."""
+    clip = rd.parse(archive_change(quat_entry(1, reference=(-32768, 0, 0)))())
+    assert clip["quat_nodes"][1]["reference"] == [-32768, 0, 0]
+    rotation = rd.rotations_at(clip, [rd.channel_value(clip, c, 3.5) for c in range(25)])[1]
+    assert sum(x * x for x in rotation) == pytest.approx(1.0)
+    assert rd.parse(with_quat_section("v3_rules.kanim", 2)())["values"] == rd.parse(vector("v3_rules.kanim"))["values"]
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(clip_counts(2 ** 24, lambda size: 32768 * size + 1)())
+    assert e.value.status == "corrupt" and "Key_Count sum" in str(e.value), str(e.value)
+
+
+# -- The runtime profile of version 5: IMAG's quaternion nodes, tracks, records of three curves
+
+def lane_of(r, j, k):
+    """File offset of component k (rx, ry, rz, rw) of quaternion node j's Quat_Reference lane."""
+    return r.entry("Quat_Reference", k * r.h["LQ"] + j, 4)
+
+
+def swap_quat_nodes(r, i, j):
+    """Quat_Node entries i and j swapped, with their Quat_Column and reference lanes."""
+    for name in ["Quat_Node", "Quat_Column"]:
+        a, b = r.get("I", r.entry(name, i, 4)), r.get("I", r.entry(name, j, 4))
+        r.put("I", r.entry(name, i, 4), b)
+        r.put("I", r.entry(name, j, 4), a)
+    for k in range(4):
+        a, b = r.get("I", lane_of(r, i, k)), r.get("I", lane_of(r, j, k))
+        r.put("I", lane_of(r, i, k), b)
+        r.put("I", lane_of(r, j, k), a)
+
+
+def key_count_of_y(r):
+    """Node 1's stored y (channel 7) one key more than its x, with CLIP's Key_Count."""
+    r.put("I", r.entry("Key_Count", 7, 4), r.get("I", r.entry("Key_Count", 7, 4)) + 1)
+    r.put("Q", r.at["CLIP"] + 24, r.get("Q", r.at["CLIP"] + 24) + 1)
+
+
+def curve_order_by_channel(r):
+    """Curves 1 and 2 (track 1's x, track 0's y) swapped in Curve_Channel and Curve_Of, as if
+    block curves were in channel order."""
+    a, b = r.get("I", r.entry("Curve_Channel", 1, 4)), r.get("I", r.entry("Curve_Channel", 2, 4))
+    r.put("I", r.entry("Curve_Channel", 1, 4), b)
+    r.put("I", r.entry("Curve_Channel", 2, 4), a)
+    r.put("I", r.entry("Curve_Of", a, 4), 2)
+    r.put("I", r.entry("Curve_Of", b, 4), 1)
+
+
+def one_track_fewer_declared(header, a):
+    """Quat_Track_Count one less, Record_Offset sized to match (R = B x (nb - 2T))."""
+    header["Quat_Track_Count"] -= 1
+    R = header["Block_Count"] * (header["Block_Curve_Count"] - 2 * header["Quat_Track_Count"])
+    a["Record_Offset"] = a["Record_Offset"][:R] + [0] * 8
+
+
+def first_three_curve_record(r):
+    return next(idx for idx in range(r.h["R"]) if len(r.record(idx)[1]["curves"]) == 3)
+
+
+def middle_list_frame_of_y(r):
+    """v5_blocks: node 2's stored y (channel 8, a list curve of 3 keys) with its middle key one
+    frame later than its x's (still increasing, the ends unchanged)."""
+    start, count = r.get("I", r.entry("Lists", r.get("I", r.entry("Curve_Of", 8, 4)) - r.h["nb"], 8)), 3
+    assert r.get("I", r.entry("Key_Count", 8, 4)) == count
+    at = r.entry("List_Frames", start + 1, 4)
+    r.put("I", at, r.get("I", at) + 1)
+
+
+V5_RUNTIME = {
+    # 9.2: the header
+    "Quat_Count > Node_Count": ("v5_quat_runtime", lambda r: r.put("I", r.at["IMAG"] + 24, r.N + 1), "Quat_Count 10 > Node_Count 9"),
+    "Quat_Track_Count > Quat_Count": ("v5_blocks_runtime", lambda r: r.put("I", r.at["IMAG"] + 28, 3), "Quat_Track_Count 3 > Quat_Count 2"),
+    "Quat_Track_Count one less (the arrays sized to it)": (lambda: writer.runtime_file(
+        vector("v5_quat.kanim"), change=one_track_fewer_declared), None, "Quat_Track_Count 1 is not the 2"),
+    # 9.2: Quat_Node (v5_quat: 1, 2 with block curves; 3, 5 without), Quat_Column, Quat_Reference
+    "Quat_Node: a node whose rotation channels are not consecutive": (
+        "v5_quat_runtime", lambda r: r.put("I", r.entry("Quat_Node", 3, 4), 6), "are not three consecutive rotation channels"),
+    "Quat_Node: a node with two rotation channels": (
+        "v5_quat_runtime", lambda r: r.put("I", r.entry("Quat_Node", 3, 4), 7), "are not three consecutive rotation channels"),
+    "Quat_Node: a node with three rotation channels about two axes": (
+        "v5_quat_runtime", lambda r: neck_about_two_axes(memoryview(r.b)[r.at["SKEL"]:]),
+        "are not three consecutive rotation channels"),
+    "Quat_Node = Node_Count": ("v5_quat_runtime", lambda r: r.put("I", r.entry("Quat_Node", 3, 4), 9), "not < Node_Count 9"),
+    "Quat_Node: the nodes without tracks not increasing": (
+        "v5_quat_runtime", lambda r: swap_quat_nodes(r, 2, 3), "not above the entry before"),
+    "Quat_Node: the tracks' nodes not increasing": (
+        "v5_quat_runtime", lambda r: swap_quat_nodes(r, 0, 1), "not above the entry before"),
+    "Quat_Node in node order, a node without a track first": (
+        "v5_blocks_runtime", lambda r: swap_quat_nodes(r, 0, 1), "has no block curves before a node with"),
+    "Quat_Column": ("v5_quat_runtime", lambda r: r.put("I", r.entry("Quat_Column", 1, 4), 10), "Quat_Column[1]"),
+    "Quat_Reference: rx not an int16 x 2^-15": (
+        "v5_quat_runtime", lambda r: r.put("f", lane_of(r, 1, 0), 0.1), "not int16 x 2^-15"),
+    "Quat_Reference: rx of 1.0 (X = 32768)": (
+        "v5_quat_runtime", lambda r: r.put("f", lane_of(r, 0, 0), 1.0), "not int16 x 2^-15"),
+    "Quat_Reference beyond the unit ball": (
+        "v5_quat_runtime", lambda r: [r.put("f", lane_of(r, 1, k), 32767 / 32768) for k in range(3)], "X^2 + Y^2 + Z^2 > 2^30"),
+    "Quat_Reference: rw one ulp off": (
+        "v5_quat_runtime", lambda r: r.put("f", lane_of(r, 1, 3), next_f32(r.get("f", lane_of(r, 1, 3)))), "lane 1 is not the reference"),
+    "Quat_Reference: rx -0.0 for X = 0": (
+        "v5_quat_runtime", lambda r: r.put("f", lane_of(r, 0, 0), -0.0), "lane 0 is not the reference (0, 0, 0)"),
+    "Quat_Reference: a padding lane": (
+        "v5_blocks_runtime", lambda r: r.put("f", lane_of(r, 3, 3), 0.0), "padding lane 3 is not (0, 0, 0, 1)"),
+    # 9.4: a quaternion node's x, y, z alike, and their shared key frames
+    "y's Key_Count unlike x's": ("v5_quat_runtime", key_count_of_y, "channel 7's Interpolation, Tension or Key_Count"),
+    "z's Tension one bit from x's": (
+        "v5_quat_runtime", lambda r: r.put("I", r.entry("Tension", 8, 4), r.get("I", r.entry("Tension", 8, 4)) ^ 1),
+        "channel 8's Interpolation, Tension or Key_Count"),
+    "y's Interpolation unlike x's": (
+        "v5_quat_runtime", lambda r: r.put("B", r.entry("Interpolation", 7, 1), r.get("B", r.entry("Interpolation", 7, 1)) ^ 1),
+        "channel 7's Interpolation, Tension or Key_Count"),
+    "a fixed y's Fixed_Frame unlike x's": (
+        "v5_quat_runtime", lambda r: r.put("I", r.entry("Fixed_Frame", 14, 4), r.get("I", r.entry("Fixed_Frame", 13, 4)) + 1),
+        "Fixed_Frame[14] is not its quaternion node's stored x's"),
+    "a list y's List_Frames unlike x's": ("v5_blocks_runtime", middle_list_frame_of_y, "List_Frames are not its quaternion node's"),
+    # 9.2: the curves' order (the tracks' x's, y's, z's first)
+    "the curves in channel order": ("v5_quat_runtime", curve_order_by_channel, "Curve_Of"),
+    # 9.3: records of three curves
+    "a quaternion track's record: z's Value_Bits 56": (
+        "v5_quat_runtime", lambda r: r.put("B", r.record(0)[0] + 10, 56), "Value_Bits 56 > 55"),
+    "a quaternion track's record: y's Value_Bits 56": (
+        "v5_quat_runtime", lambda r: r.put("B", r.record(0)[0] + 9, 56), "Value_Bits 56 > 55"),
+    "a quaternion track's record: Context_Bits 32": (
+        "v5_quat_runtime", lambda r: r.put("B", r.record(0)[0] + 11, 32), "Context_Bits 32 > 31"),
+    "a quaternion track's record: a bit after its fields": (
+        "v5_quat_runtime", lambda r: set_record_bits_after_fields(r, tracks_of=3), "bits after its last field"),
+    "a quaternion track's record: its window out of order": (
+        "v5_quat_runtime", lambda r: swap_context_0_into_1(r, first_three_curve_record(r)), "window frames out of order"),
+    # 9.1.2: no QUAT in the runtime profile of version 5
+    "a QUAT section": (lambda: with_table(vector("v5_quat_runtime.kanim"), *[a + b for a, b in zip(
+        sections(vector("v5_quat_runtime.kanim")), [[(b"QUAT", 0, 4, 4)], [bytes(4)]])]), None, "QUAT in a runtime-profile file"),
+    "an ancillary QUAT section": (lambda: with_table(vector("v5_quat_runtime.kanim"), *[a + b for a, b in zip(
+        sections(vector("v5_quat_runtime.kanim")), [[(b"QUAT", 2, 4, 4)], [bytes(4)]])]), None, "QUAT in a runtime-profile file"),
+}
+V5_STRUCTURE = {}
+for _name, (_source, _change, _message) in V5_RUNTIME.items():
+    _make = _source if callable(_source) else (lambda s, c: lambda: mutate(c)(f"{s}.kanim"))(_source, _change)
+    V5_STRUCTURE[f"v5: {_name}"] = (_make, "corrupt", _message)
+# Version 4: Quat_Count is reserved (Image_Reserved), QUAT an unknown tag.
+V5_STRUCTURE["v4: Quat_Count"] = (mutate(lambda r: r.put("I", r.at["IMAG"] + 24, 1)), "reserved_bits_set", "Image_Reserved")
+V5_STRUCTURE["v4: a critical QUAT section"] = (lambda: append_section(b"QUAT", 0), "reserved_bits_set", "unknown critical")
+
+
+@pytest.mark.parametrize("case", list(V5_STRUCTURE))
+def test_a_broken_version_5_structure_rule_is_refused(case):
+    make, status, message = V5_STRUCTURE[case]
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(make(), check_content=False)  # a structure rule: refused without the content checks
+    assert e.value.status == status, str(e.value)
+    assert message in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("case", list(V5_STRUCTURE))
+def test_keyanim_refuses_the_broken_version_5_structure_too(case, tmp_path):
+    make, status, _ = V5_STRUCTURE[case]
+    cli_refuses(make(), status, tmp_path)
+
+
+def test_version_4_skips_an_ancillary_quat_section():
+    """QUAT is a tag of version 5: a version 4 file may hold an ancillary one, unknown to it."""
+    assert rd.parse(append_section(b"QUAT", 2))["values"] == rd.parse(vector("v4_rules.kanim"))["values"]
+
+
+V5_CONTENT = {
+    # Track 0 is node 1's: curves 0, 2, 4 (T = 2). A context value of its y, and the Base of its z.
+    "a quaternion track's y context value": (lambda r: change_value_field(r, 0, 0, curve=1),
+                                             "record of block 0, curve 2: Values"),
+    "a quaternion track's z Base": (lambda r: change_base(r, 0, 2), "First_Value[4]"),
+}
+
+
+@pytest.mark.parametrize("case", list(V5_CONTENT))
+def test_a_broken_version_5_content_rule_is_refused_by_the_content_check(case):
+    change, message = V5_CONTENT[case]
+    data = mutate(change)("v5_quat_runtime.kanim")
+    assert rd.parse(data, check_content=False)["version"] == (5, 0)  # every structure rule holds
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(data)
+    assert e.value.status == "corrupt" and message in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("case", list(V5_CONTENT))
+def test_keyanim_convert_refuses_the_broken_version_5_content_too(case, tmp_path):
+    cli_refuses(mutate(V5_CONTENT[case][0])("v5_quat_runtime.kanim"), "corrupt", tmp_path)
 
 
 if __name__ == "__main__":

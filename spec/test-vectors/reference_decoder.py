@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Reference decoder for .kanim 4.1 (both profiles, and banks: section 10) and 3.0, 2.0, 1.0
-(Appendix E), written from spec/FORMAT.md alone.
+"""Reference decoder for .kanim 5.0 (both profiles, quaternion nodes: 4.7, and banks: section 10),
+4.1, 4.0, 3.0, 2.0 and 1.0 (Appendix E), written from spec/FORMAT.md alone.
 
 It shares no code with the C++ library: it parses the bytes, checks the rules of the spec,
 and evaluates Appendix A in binary32 (every operation computed in binary64 and rounded once to
@@ -10,13 +10,20 @@ rule of 9.4, and then its content checked too: the image is rebuilt from the rec
 compared field by field (9.4 lets a decoder skip this; an independent check should not). Its
 keys are then evaluated by the same Appendix A code as an archive file's.
 
+Version 5 adds quaternion nodes (4.7): a node's three rotation channels hold the x, y, z of its
+rotation relative to a reference, on key frames the three share. Their stored values are
+evaluated by Appendix A like any channel's; a vector's JSON then also lists the quaternion nodes
+and, at each position, their rotations computed in binary64 from the stored values (4.7).
+
 A bank (section 10) is opened from its header, tables, names and Bank_Checksum (10.1-10.4);
 each member is decoded on request (10.5) with the bank's skeleton as its SKEL, and a failure
 names the clip and gives offsets from the bank's first byte.
 
 Usage:
   reference_decoder.py FILE.kanim [POSITION ...]   print the values at these frame positions
-  reference_decoder.py --write-json DIR            write DIR/NAME.json for every DIR/*.kanim
+  reference_decoder.py --write-json DIR            write DIR/NAME.json for every DIR/*.kanim (one
+                                                   that exists is left as it is; if its values
+                                                   differ, exit status 1)
   reference_decoder.py BANK                        print the bank's clip index as JSON
   reference_decoder.py BANK NAME                   print clip NAME's expected values as JSON, as
                                                    the .json beside a .kanim vector holds them
@@ -44,6 +51,8 @@ import zlib
 SIGNATURE = bytes([0x89, 0x4B, 0x41, 0x4E, 0x0D, 0x0A, 0x1A, 0x0A])
 CHANNEL_NAMES = ["Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation"]
 CRITICAL = ["CLIP", "SKEL", "CHAN", "KTIM", "KVAL"]
+CRITICAL_V5 = ["CLIP", "SKEL", "QUAT", "CHAN", "KTIM", "KVAL"]  # 3.2.3: QUAT between SKEL and CHAN
+QUAT_VERSION = 5  # the first Major_Version with quaternion nodes (4.7)
 
 
 class KanimError(Exception):
@@ -154,8 +163,8 @@ def parse(data, check_content=True):
     A bank (section 10) is not a clip: open_bank reads it."""
     major, minor, runtime, count = parse_header(data)
     if runtime:
-        return parse_runtime(data, minor, count, check_content)
-    return decode_archive(archive_sections(data, count), major, minor)
+        return parse_runtime(data, major, minor, count, check_content)
+    return decode_archive(archive_sections(data, count, major), major, minor, len(data))
 
 
 MEMBER, BANK = 2, 4  # Header_Flags bits 1 and 2 (version 4.1 on, section 10)
@@ -170,11 +179,11 @@ def parse_header(data, member=False):
     if len(data) < 24:
         raise KanimError("truncated", "header", len(data))
     major, minor, header_flags, count, reserved = struct.unpack_from("<HHIII", data, 8)
-    if major not in (1, 2, 3, 4):
+    if major not in (1, 2, 3, 4, 5):
         raise KanimError("unsupported_version", f"major {major}", 8)
-    # Version 4: bit 0 Runtime (section 9), bits 1 Member and 2 Bank (4.1, section 10); before
-    # version 4 all three are reserved, and bits 3-15 always are.
-    if header_flags & (0xFFF8 if major == 4 else 0xFFFF):
+    # Versions 4 and 5: bit 0 Runtime (section 9), bits 1 Member and 2 Bank (4.1, section 10);
+    # before version 4 all three are reserved, and bits 3-15 always are.
+    if header_flags & (0xFFF8 if major >= 4 else 0xFFFF):
         raise KanimError("reserved_bits_set", "header: Header_Flags", 12)
     if header_flags & BANK:
         raise KanimError("corrupt", "header: Header_Flags has Bank set: a bank (section 10), not a clip", 12)
@@ -187,8 +196,15 @@ def parse_header(data, member=False):
     return major, minor, bool(header_flags & 1), count
 
 
-def parse_clip(clip):
-    """CLIP (4.1): (F, N, C, Tangent_Rule, Frame_Time, K)."""
+# Section 8: a key takes at least a third of a byte of a version 5 KTIM (a quaternion node's three
+# keys at a frame share one varint), and a zstd frame makes at most 32768 bytes of each byte.
+KEYS_PER_FILE_BYTE_V5 = 3 * 32768
+
+
+def parse_clip(clip, file_size=None):
+    """CLIP (4.1): (F, N, C, Tangent_Rule, Frame_Time, K). file_size: the bytes of a version 5
+    archive file (or member), whose K section 8 bounds by them as soon as it is read, before
+    anything it sizes (versions 1 to 4 are read as before, without that bound)."""
     if len(clip) != 32:
         raise KanimError("corrupt", "CLIP size")
     F, N, C, rule, clip_flags, clip_reserved, frame_time, K = struct.unpack("<IIIBBHdQ", clip)
@@ -196,6 +212,9 @@ def parse_clip(clip):
         raise KanimError("reserved_bits_set", "CLIP")
     if not math.isfinite(frame_time) or frame_time < 0 or (F > 1 and not frame_time > 0):
         raise KanimError("corrupt", "Frame_Time")
+    if file_size is not None and K > KEYS_PER_FILE_BYTE_V5 * file_size:  # fields in order (section 7)
+        raise KanimError("corrupt", f"CLIP: Key_Count {K} > 98304 x the file's {file_size} bytes (section 8): "
+                         "more keys than KTIM can hold")
     if K > C * F:
         raise KanimError("corrupt", "Key_Count")
     return F, N, C, rule, frame_time, K
@@ -230,10 +249,94 @@ def parse_skel(skel, N, C):
     return nodes
 
 
-def archive_sections(data, count, member=False, dictionary=None):
+# ---- Quaternion nodes (version 5, 4.7): the archive profile's QUAT, the runtime profile's
+# Quat_Node, and the rotation a node's stored x, y, z make.
+
+def quat_node_columns(nodes, quat_nodes, where, increasing=True):
+    """4.7's rules on the listed nodes against SKEL: each < N with exactly three rotation
+    channels, consecutive in its channel list, one about each of X, Y and Z, and (increasing)
+    strictly increasing, as QUAT lists them (IMAG orders them otherwise: check_quat_node_order).
+    Returns each node's stored x: the frame column of its first rotation channel (stored y and
+    z are the next two, whatever axes the three are about)."""
+    first, total = [], 0
+    for node in nodes:
+        first.append(total)
+        total += len(node["channels"])
+    columns = []
+    for j, n in enumerate(quat_nodes):
+        if n >= len(nodes):
+            raise KanimError("corrupt", f"{where}: entry {j}: Node {n} not < Node_Count {len(nodes)} (4.7)")
+        if increasing and j and n <= quat_nodes[j - 1]:
+            raise KanimError("corrupt", f"{where}: entry {j}: Node {n} not above the entry before (4.7)")
+        types = nodes[n]["channels"]
+        rotations = [k for k, t in enumerate(types) if t.endswith("rotation")]
+        if (len(rotations) != 3 or rotations[2] - rotations[0] != 2 or
+                sorted(types[k][0] for k in rotations) != ["X", "Y", "Z"]):
+            raise KanimError("corrupt", f"{where}: entry {j}: node {n}'s channels {types} are not three consecutive "
+                             "rotation channels about X, Y and Z (4.7)")
+        columns.append(first[n] + rotations[0])
+    return columns
+
+
+def check_reference(X, Y, Z, where):
+    """4.7: a reference of three int16 lies in the unit ball of 2^15."""
+    if X * X + Y * Y + Z * Z > 2 ** 30:
+        raise KanimError("corrupt", f"{where}: Reference ({X}, {Y}, {Z}) has X^2 + Y^2 + Z^2 > 2^30 (4.7)")
+
+
+def parse_quat(quat, nodes):
+    """QUAT (4.7): [{node, reference: [X, Y, Z], column: its stored x's channel}], after its
+    size, its nodes against SKEL and its references."""
+    N = len(nodes)
+    if len(quat) < 4:
+        raise KanimError("corrupt", "QUAT: shorter than Quat_Count")
+    (Q,) = struct.unpack_from("<I", quat, 0)
+    if Q > N:
+        raise KanimError("corrupt", f"QUAT: Quat_Count {Q} > Node_Count {N}")
+    if len(quat) != 4 + 10 * Q:
+        raise KanimError("corrupt", f"QUAT: Raw_Size {len(quat)} != 4 + 10 x Quat_Count {Q}")
+    entries = [struct.unpack_from("<I3h", quat, 4 + 10 * j) for j in range(Q)]
+    columns = quat_node_columns(nodes, [e[0] for e in entries], "QUAT")
+    for j, (node, X, Y, Z) in enumerate(entries):
+        check_reference(X, Y, Z, f"QUAT: entry {j}")
+    return [{"node": e[0], "reference": list(e[1:]), "column": c} for e, c in zip(entries, columns)]
+
+
+def reference_lanes(X, Y, Z):
+    """9.2's Quat_Reference lanes of reference (X, Y, Z): rx, ry, rz exact in binary32, and rw
+    the binary64 square root rounded to binary32."""
+    return [f32(X * 2.0 ** -15), f32(Y * 2.0 ** -15), f32(Z * 2.0 ** -15),
+            f32(math.sqrt(1.0 - (X * X + Y * Y + Z * Z) * 2.0 ** -30))]
+
+
+def hamilton(a, b):
+    """The Hamilton product a b of quaternions written (x, y, z, w), as 4.7 spells it out."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def quat_rotation(reference, sx, sy, sz):
+    """4.7: the rotation (x, y, z, w) of a quaternion node with this reference (X, Y, Z) and
+    stored values sx, sy, sz (binary32), in binary64: r (s, w) normalized. The stored values
+    are exact; the spec leaves the precision of the rest to the decoder."""
+    X, Y, Z = reference
+    r = (X * 2.0 ** -15, Y * 2.0 ** -15, Z * 2.0 ** -15, math.sqrt(1.0 - (X * X + Y * Y + Z * Z) * 2.0 ** -30))
+    w = math.sqrt(max(0.0, 1.0 - (sx * sx + sy * sy + sz * sz)))
+    q = hamilton(r, (sx, sy, sz, w))
+    norm = math.sqrt(sum(x * x for x in q))  # >= 1 - rounding: |r| = 1, |(s, w)| >= 1
+    return [x / norm for x in q]
+
+
+def archive_sections(data, count, major, member=False, dictionary=None):
     """Rules 3.1-3.3 on an archive-profile file's table, sizes and CRC-32: {tag: content} of
-    the known sections, decompressed (with a bank's dictionary, 10.4). member: a bank's member,
-    whose table holds no SKEL (10.5.2)."""
+    the known sections, decompressed (with a bank's dictionary, 10.4). major: the file's
+    Major_Version (version 5 has QUAT, an unknown critical tag before). member: a bank's
+    member, whose table holds no SKEL (10.5.2)."""
+    critical = CRITICAL_V5 if major >= QUAT_VERSION else CRITICAL
     if len(data) < 24 + 24 * count + 4:
         raise KanimError("truncated", "table")
     sections = []
@@ -258,7 +361,7 @@ def archive_sections(data, count, member=False, dictionary=None):
         ancillary = bool(flags & 2)
         if member and tag == "SKEL":
             raise KanimError("corrupt", "a SKEL section in a bank's member (10.5.2)")
-        if tag in CRITICAL:
+        if tag in critical:
             if ancillary:
                 raise KanimError("corrupt", f"{tag} marked ancillary")
             critical_seen.append(tag)
@@ -281,17 +384,25 @@ def archive_sections(data, count, member=False, dictionary=None):
                 raise KanimError("corrupt", f"{tag}: raw size")
             body = stored
         content[tag] = body
-    if critical_seen != [t for t in CRITICAL if not (member and t == "SKEL")]:
+    if critical_seen != [t for t in critical if not (member and t == "SKEL")]:
         raise KanimError("corrupt", f"critical sections {critical_seen}")
     return content
 
 
-def decode_archive(content, major, minor):
-    """The archive profile's sections (4.1-4.6, 5): versions 1 to 3, and 4 with Runtime clear
-    (laid out as 3.0). content: {tag: content}, SKEL's being a bank's skeleton for a member."""
-    layout = min(major, 3)  # 4.0's archive profile has 3.0's bytes (section 9)
-    F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
+def decode_archive(content, major, minor, file_size):
+    """The archive profile's sections (4.1-4.7, 5): versions 1 to 3, 4 with Runtime clear
+    (laid out as 3.0), and 5 (3.0's layout, with QUAT and the key frames a quaternion node's
+    x, y, z share). content: {tag: content}, SKEL's being a bank's skeleton for a member;
+    file_size: the file's (the member's) bytes."""
+    layout = min(major, 3)  # 4.0's and 5.0's archive profile have 3.0's bytes (sections 4.3-4.5, 9)
+    v5 = major >= QUAT_VERSION
+    F, N, C, rule, frame_time, K = parse_clip(content["CLIP"], file_size if v5 else None)
     nodes = parse_skel(content["SKEL"], N, C)
+    quats = parse_quat(content["QUAT"], nodes) if v5 else []
+    # Each quaternion node's stored y and z take the key frames of its stored x (4.4).
+    shares_frames_of = {}
+    for quat in quats:
+        shares_frames_of[quat["column"] + 1] = shares_frames_of[quat["column"] + 2] = quat["column"]
 
     # CHAN
     chan = content["CHAN"]
@@ -318,6 +429,12 @@ def decode_archive(content, major, minor):
             raise KanimError("reserved_bits_set", f"channel {c} value coding")
         if residual_bytes is not None and (residual_bytes[c] > 8 or (key_count[c] == 0 and residual_bytes[c])):
             raise KanimError("corrupt", f"channel {c} residual bytes")
+    for j, quat in enumerate(quats):  # 4.3: one Interpolation, Tension (bits) and Key_Count for x, y, z
+        x = quat["column"]
+        for c in (x + 1, x + 2):
+            if (interp[c], f32_bits(tension[c]), key_count[c]) != (interp[x], f32_bits(tension[x]), key_count[x]):
+                raise KanimError("corrupt", f"CHAN: quaternion node {quat['node']} (QUAT entry {j}): channel {c}'s "
+                                 f"Interpolation, Tension or Key_Count is not its stored x's (channel {x}'s) (4.3)")
     if sum(key_count) != K:
         raise KanimError("corrupt", "Key_Count sum")
 
@@ -325,6 +442,9 @@ def decode_archive(content, major, minor):
     r = Reader(content["KTIM"], "KTIM")
     frames = []
     for c in range(C):
+        if c in shares_frames_of:  # no varints: a quaternion node's y and z (4.4)
+            frames.append(list(frames[shares_frames_of[c]]))
+            continue
         fr = []
         for i in range(key_count[c]):
             v = r.varint(5, 32)
@@ -393,7 +513,7 @@ def decode_archive(content, major, minor):
             return qs[i - 1] + (2 * d * g1 + g0) // (2 * g0)
         return qs[i - 1] + d
 
-    values = []
+    values, quantized = [], []
     for c in range(C):
         qs, vals = [], []
         for i in range(key_count[c]):
@@ -410,11 +530,13 @@ def decode_archive(content, major, minor):
                 raise KanimError("corrupt", f"channel {c} value")
             vals.append(v)
         values.append(vals)
+        quantized.append(qs)
     if layout < 3 and not all(p.at_end() for p in planes):
         raise KanimError("corrupt", "KVAL plane bytes left over")
 
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": interp, "tension": tension, "frames": frames, "values": values,
+            "q": quantized, "step": step, "quat_nodes": quats,
             "notes": content.get("NOTE", b"").decode("utf-8", errors="surrogateescape")}
 
 
@@ -479,14 +601,17 @@ def xxh64(data):
 RUNTIME_SECTIONS = ["CLIP", "IMAG", "SKEL"]
 
 
-def runtime_sections(data, count, member=False):
+def runtime_sections(data, count, major, member=False):
     """Rules 3.1 and 9.1 on the table: CLIP, IMAG, SKEL at entries 0-2, then at most one NOTE
     (ancillary) and unknown ancillary sections, in any order; nothing compressed; the XXH64 at
-    the end. Returns {tag: content} of the known sections. member: a bank's member, whose
-    table has CLIP and IMAG only at entries 0-1 and no SKEL anywhere (10.5.2)."""
+    the end. Returns {tag: content} of the known sections. major: the file's Major_Version (in
+    version 5 a QUAT section is refused as CHAN is, 9.1.2; before, it is an unknown tag).
+    member: a bank's member, whose table has CLIP and IMAG only at entries 0-1 and no SKEL
+    anywhere (10.5.2)."""
     if len(data) < 24 + 24 * count + 8:
         raise KanimError("truncated", "table")
     fixed = RUNTIME_SECTIONS[:2] if member else RUNTIME_SECTIONS
+    refused = RUNTIME_SECTIONS + (CRITICAL_V5 if major >= QUAT_VERSION else CRITICAL)
     entries = [struct.unpack_from("<4sIQQ", data, 24 + 24 * i) for i in range(count)]
     tags = [e[0].decode("latin-1") for e in entries]
     for i, (_, flags, stored, raw) in enumerate(entries):
@@ -499,7 +624,7 @@ def runtime_sections(data, count, member=False):
             raise KanimError("corrupt", f"table entry {i}: must be {fixed[i]}, critical (9.1)", at)
         if i >= len(fixed) and tag == "NOTE" and (not ancillary or tag in tags[len(fixed):i]):
             raise KanimError("corrupt", f"table entry {i}: NOTE must be ancillary, and appear once (9.1)", at)
-        if i >= len(fixed) and tag in RUNTIME_SECTIONS + CRITICAL:
+        if i >= len(fixed) and tag in refused:
             raise KanimError("corrupt", f"table entry {i}: {tag} in a runtime-profile file (9.1)", at)
         if i >= len(fixed) and tag != "NOTE" and not ancillary:
             raise KanimError("reserved_bits_set", f"table entry {i}: unknown critical section {tag}", at)
@@ -524,23 +649,30 @@ def runtime_sections(data, count, member=False):
     return content
 
 
-def parse_runtime(data, minor, count, check_content=True):
+def parse_runtime(data, major, minor, count, check_content=True):
     """A runtime-profile file (section 9): its keys recovered from IMAG, structure and content
     checked (9.4), in the same dict as decode_archive's."""
-    return decode_runtime(runtime_sections(data, count), minor, check_content)
+    return decode_runtime(runtime_sections(data, count, major), major, minor, check_content)
 
 
-def decode_runtime(content, minor, check_content=True):
+def decode_runtime(content, major, minor, check_content=True):
     """The runtime profile's sections (9.2-9.4). content: {tag: content}, SKEL's being a bank's
     skeleton for a member."""
     F, N, C, rule, frame_time, K = parse_clip(content["CLIP"])
-    image = parse_image(content["IMAG"], F, C, K)
+    # Version 5 checks IMAG's quaternion nodes against SKEL, so reads SKEL first (9.4); version
+    # 4 keeps the table's order (CLIP, IMAG, SKEL), as before.
+    nodes = parse_skel(content["SKEL"], N, C) if major >= QUAT_VERSION else None
+    image = parse_image(content["IMAG"], F, C, K, major, nodes)
     if check_content:
         check_image_content(image)
-    nodes = parse_skel(content["SKEL"], N, C)
-    return {"version": (4, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
+    if nodes is None:
+        nodes = parse_skel(content["SKEL"], N, C)
+    return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": image["interp"], "tension": image["tension"],
             "frames": image["frames"], "values": image["values"],
+            # In node order, as QUAT lists them (IMAG lists the quaternion tracks' nodes first):
+            # the clip's facts do not depend on its profile.
+            "quat_nodes": sorted(image["quat_nodes"], key=lambda quat: quat["node"]),
             "notes": content.get("NOTE", b"").decode("utf-8", errors="surrogateescape")}
 
 
@@ -550,11 +682,13 @@ def pad8(n):
     return (n + 7) // 8 * 8
 
 
-def image_header(body, F, C):
-    """IMAG's 32-byte header: the counts that size its arrays (9.2)."""
+def image_header(body, F, C, N, major):
+    """IMAG's 32-byte header: the counts that size its arrays (9.2). Quat_Track_Count (T) sizes
+    Record_Offset as declared (R = B x (nb - 2T)); that it counts the quaternion nodes whose
+    curves are block curves is checked with the quaternion nodes (check_quat_node_order)."""
     if len(body) < 32:
         raise KanimError("corrupt", "IMAG: header")
-    shift, nc, nb, B, M, P, reserved0, reserved1 = struct.unpack_from("<8I", body, 0)
+    shift, nc, nb, B, M, P, Q, T = struct.unpack_from("<8I", body, 0)
     if shift != 6:
         raise KanimError("corrupt", "IMAG: Block_Shift")
     if nc > C:
@@ -563,20 +697,29 @@ def image_header(body, F, C):
         raise KanimError("corrupt", "IMAG: Block_Curve_Count")
     if B != ((F + 63) // 64 if nc else 0):
         raise KanimError("corrupt", "IMAG: Block_Count")
-    if reserved0 or reserved1:
+    if major < QUAT_VERSION and (Q or T):  # version 4's Image_Reserved
         raise KanimError("reserved_bits_set", "IMAG: Image_Reserved")
+    if major >= QUAT_VERSION and Q > N:
+        raise KanimError("corrupt", f"IMAG: Quat_Count {Q} > Node_Count {N}")
+    # T of the Q nodes have three block curves each: checked here only as far as the sizes
+    # need (nt = nb - 2T is a count), against the nodes themselves later.
+    if T > Q or 3 * T > nb:
+        raise KanimError("corrupt", f"IMAG: Quat_Track_Count {T} > Quat_Count {Q} or 3 x {T} > Block_Curve_Count {nb}")
+    nt = nb - 2 * T  # every quaternion track's three block curves one track, every other one its own
     return {"nc": nc, "nb": nb, "nl": nc - nb, "B": B, "M": M, "P": P, "L": 4 * ((nc + 3) // 4),
-            "X": C - nc, "R": B * nb, "F": F, "C": C}
+            "X": C - nc, "Q": Q, "LQ": 4 * ((Q + 3) // 4), "T": T, "nt": nt, "R": B * nt, "F": F, "C": C}
 
 
 def image_array_specs(h):
-    """(name, struct format of one entry, entries) of IMAG's arrays, in file order (9.2)."""
-    C, L, nc, M = h["C"], h["L"], h["nc"], h["M"]
+    """(name, struct format of one entry, entries) of IMAG's arrays, in file order (9.2); the
+    quaternion nodes' arrays are empty in version 4 (Q = 0)."""
+    C, L, nc, M, Q = h["C"], h["L"], h["nc"], h["M"], h["Q"]
     return [("Interpolation", "B", C), ("Tension", "f", C), ("Key_Count", "I", C),
             ("Curve_Of", "I", C), ("Fixed_Value", "f", C), ("Fixed_Frame", "I", C),
             ("Fixed_Channels", "I", h["X"]), ("Curves", "qdII", nc), ("Curve_S", "f", L),
             ("First_Frame", "f", L), ("Last_Frame", "f", L), ("First_Value", "f", L),
             ("Last_Value", "f", L), ("Curve_Linear", "I", L), ("Curve_Channel", "I", nc),
+            ("Quat_Node", "I", Q), ("Quat_Column", "I", Q), ("Quat_Reference", "f", 4 * h["LQ"]),
             ("Lists", "II", h["nl"]), ("List_Frames", "I", M), ("List_Values", "f", M),
             ("List_Q", "q", M), ("Record_Offset", "I", h["R"] + 8), ("Payload", None, h["P"] + 8)]
 
@@ -606,8 +749,8 @@ def image_arrays(body, h):
 
 # ---- IMAG (9.2): the rules of its tables.
 
-def check_channel_arrays(a, h, K):
-    """The per-channel arrays, and which channels are block curves, list curves, fixed (9.2)."""
+def check_channel_values(a, h, K):
+    """The per-channel facts of 9.2: Interpolation, Tension, Key_Count and its sum."""
     F, C, n = h["F"], h["C"], a["Key_Count"]
     for c in range(C):
         if a["Interpolation"][c] > 1:
@@ -621,10 +764,26 @@ def check_channel_arrays(a, h, K):
             raise KanimError("corrupt", f"IMAG: Key_Count[{c}] > Frame_Count")
     if sum(n) != K:
         raise KanimError("corrupt", "IMAG: Key_Count sum != CLIP's Key_Count")
-    # A list curve has fewer keys than a quarter of the blocks (9.2); block curves come first.
+
+
+def is_block_curve(a, h, c):
+    """9.2: a curve (n_c >= 2) with at least a quarter as many keys as blocks."""
+    n = a["Key_Count"][c]
+    return n >= 2 and not 4 * n < (h["F"] + 63) // 64
+
+
+def check_channel_arrays(a, h, quats):
+    """Which channels are block curves, list curves, fixed (9.2), and the curves' order: the
+    quaternion tracks' x's, y's, z's (quats: the checked quaternion nodes, tracks first), then
+    the other block curves, then the list curves, each in increasing channel order. Returns
+    the block tracks' curves (9.2: nt of them)."""
+    C, n = h["C"], a["Key_Count"]
     curves = [c for c in range(C) if n[c] >= 2]
-    lists = [c for c in curves if 4 * n[c] < (F + 63) // 64]
-    order = [c for c in curves if c not in lists] + lists
+    lists = [c for c in curves if not is_block_curve(a, h, c)]
+    track_x = [quat["column"] for quat in quats if is_block_curve(a, h, quat["column"])]
+    in_tracks = {x + k for x in track_x for k in range(3)}
+    order = ([x for x in track_x] + [x + 1 for x in track_x] + [x + 2 for x in track_x] +
+             [c for c in curves if c not in lists and c not in in_tracks] + lists)
     if len(curves) != h["nc"] or len(order) - len(lists) != h["nb"]:
         raise KanimError("corrupt", "IMAG: Curve_Count or Block_Curve_Count against Key_Count")
     curve_of = [0xFFFFFFFF] * C
@@ -637,12 +796,14 @@ def check_channel_arrays(a, h, K):
         one = n[c] == 1
         if one and not math.isfinite(a["Fixed_Value"][c]) or not one and a["Fixed_Value_bits"][c] != 0:
             raise KanimError("corrupt", f"IMAG: Fixed_Value[{c}]")
-        if one and a["Fixed_Frame"][c] >= F or not one and a["Fixed_Frame"][c] != 0:
+        if one and a["Fixed_Frame"][c] >= h["F"] or not one and a["Fixed_Frame"][c] != 0:
             raise KanimError("corrupt", f"IMAG: Fixed_Frame[{c}]")
     if a["Fixed_Channels"] != [c for c in range(C) if n[c] <= 1]:
         raise KanimError("corrupt", "IMAG: Fixed_Channels")
     if a["Curve_Channel"] != order:
         raise KanimError("corrupt", "IMAG: Curve_Channel")
+    T = len(track_x)  # track t: curves t, T + t, 2T + t; then each other block curve alone
+    return [[t, T + t, 2 * T + t] for t in range(T)] + [[i] for i in range(3 * T, h["nb"])]
 
 
 INF32_BITS = 0x7F800000
@@ -672,6 +833,83 @@ def check_curve_arrays(a, h):
         linear = 0xFFFFFFFF if i < nc and a["Interpolation"][c] == 1 else 0
         if a["Curve_Linear"][i] != linear:
             raise KanimError("corrupt", f"IMAG: Curve_Linear[{i}]")
+
+
+ONE32_BITS = 0x3F800000
+
+
+def check_quat_arrays(a, h, nodes):
+    """Version 5: Quat_Node against SKEL (4.7), Quat_Column, Quat_Reference's lanes (and its
+    padding lanes (0, 0, 0, 1)), each quaternion node's stored x, y, z with one Interpolation,
+    Tension (bits) and Key_Count (9.2, 9.4), then the nodes' order and Quat_Track_Count.
+    Returns [{node, reference, column}] in Quat_Node's order, as parse_quat does, the
+    reference's X, Y, Z read back from rx, ry, rz."""
+    Q, LQ, lanes = h["Q"], h["LQ"], a["Quat_Reference_bits"]
+    if not LQ:
+        return []  # version 4, or a version 5 clip without quaternion nodes
+    columns = quat_node_columns(nodes, a["Quat_Node"], "IMAG: Quat_Node", increasing=False)
+    for j in range(Q):
+        if a["Quat_Column"][j] != columns[j]:
+            raise KanimError("corrupt", f"IMAG: Quat_Column[{j}] {a['Quat_Column'][j]} is not node "
+                             f"{a['Quat_Node'][j]}'s first rotation channel {columns[j]}")
+    quats = []
+    for j in range(LQ):
+        got = [lanes[k * LQ + j] for k in range(4)]  # rx, ry, rz, rw: four arrays of LQ
+        if j >= Q:
+            if got != [0, 0, 0, ONE32_BITS]:
+                raise KanimError("corrupt", f"IMAG: Quat_Reference padding lane {j} is not (0, 0, 0, 1)")
+            continue
+        scaled = [a["Quat_Reference"][k * LQ + j] * 32768.0 for k in range(3)]
+        if not all(v.is_integer() and -32768 <= v <= 32767 for v in scaled):
+            raise KanimError("corrupt", f"IMAG: Quat_Reference lane {j}: rx, ry, rz are not int16 x 2^-15")
+        X, Y, Z = (int(v) for v in scaled)
+        check_reference(X, Y, Z, f"IMAG: Quat_Reference lane {j}")
+        if got != [f32_bits(v) for v in reference_lanes(X, Y, Z)]:  # bits: -0.0 is not the X of 0
+            raise KanimError("corrupt", f"IMAG: Quat_Reference lane {j} is not the reference ({X}, {Y}, {Z}) as 9.2 "
+                             "rounds it")
+        quats.append({"node": a["Quat_Node"][j], "reference": [X, Y, Z], "column": columns[j]})
+    for j, quat in enumerate(quats):
+        x = quat["column"]
+        for c in (x + 1, x + 2):
+            if ((a["Interpolation"][c], a["Tension_bits"][c], a["Key_Count"][c]) !=
+                    (a["Interpolation"][x], a["Tension_bits"][x], a["Key_Count"][x])):
+                raise KanimError("corrupt", f"IMAG: quaternion node {quat['node']} (entry {j}): channel {c}'s "
+                                 f"Interpolation, Tension or Key_Count is not its stored x's (channel {x}'s)")
+    check_quat_node_order(a, h, quats)
+    return quats
+
+
+def check_quat_node_order(a, h, quats):
+    """Quat_Node's order (9.2): first the T quaternion tracks' nodes (whose x, y, z are block
+    curves), then the others, each part strictly increasing; and Quat_Track_Count = T."""
+    tracks = [is_block_curve(a, h, quat["column"]) for quat in quats]
+    T = sum(tracks)
+    for j, quat in enumerate(quats):
+        if tracks[j] != (j < T):
+            raise KanimError("corrupt", f"IMAG: Quat_Node[{j}]: node {quat['node']} " +
+                             ("has block curves after a node without" if tracks[j] else "has no block curves before a "
+                              "node with") + " (9.2: the quaternion tracks' nodes first)")
+        if j not in (0, T) and quat["node"] <= quats[j - 1]["node"]:
+            raise KanimError("corrupt", f"IMAG: Quat_Node[{j}]: node {quat['node']} not above the entry before (9.2)")
+    if h["T"] != T:
+        raise KanimError("corrupt", f"IMAG: Quat_Track_Count {h['T']} is not the {T} quaternion nodes whose curves "
+                         "are block curves")
+
+
+def check_quat_key_frames(a, h, quats, keys):
+    """A quaternion node's stored x, y, z share their key frames (4.3, 4.4). A track of three
+    holds them once (one Mask); list curves and fixed channels hold each channel's own, so
+    theirs must be equal."""
+    for j, quat in enumerate(quats):
+        x = quat["column"]
+        n, curve = a["Key_Count"][x], a["Curve_Of"][x]
+        for c in (x + 1, x + 2):
+            if n == 1 and a["Fixed_Frame"][c] != a["Fixed_Frame"][x]:
+                raise KanimError("corrupt", f"IMAG: Fixed_Frame[{c}] is not its quaternion node's stored x's "
+                                 f"(channel {x}): they share key frames (4.4)")
+            if n >= 2 and curve >= h["nb"] and keys[a["Curve_Of"][c]][0] != keys[curve][0]:
+                raise KanimError("corrupt", f"IMAG: list curve {a['Curve_Of'][c]}'s List_Frames are not its quaternion "
+                                 f"node's stored x's (curve {curve}): they share key frames (4.4)")
 
 
 def check_curve_ends(a, i, frames, values, with_values):
@@ -726,55 +964,66 @@ def zigzag(d):
     return 2 * d if d >= 0 else -2 * d - 1
 
 
-def read_record(payload, pos, P, wc, b, F, where):
-    """Block b's record at byte pos of Payload: its fields, after the structure rules of 9.3
-    and 9.4 (widths, size within Payload_Size, zero bits after it, Mask, window order)."""
-    if pos + 10 > P:
+def read_record(payload, pos, P, wcs, b, F, where):
+    """Block b's record at byte pos of Payload of a track of one curve or three (wcs: their
+    Base_Bits), after the structure rules of 9.3 and 9.4 (widths, size within Payload_Size,
+    zero bits after it, Mask, window order). Returns its size and, for each curve, its fields
+    as a record of that curve alone would hold them (the Mask, Context_Bits and Context are
+    the three's)."""
+    n = len(wcs)
+    head = 64 + 8 * n + 8  # Mask, one Value_Bits a curve, Context_Bits: 80 bits, or 96 for three
+    if pos + head // 8 > P:
         raise KanimError("corrupt", f"IMAG: {where} runs past Payload_Size")
     mask = struct.unpack_from("<Q", payload, pos)[0]
     if F - 64 * b < 64 and mask >> (F - 64 * b):
         raise KanimError("corrupt", f"IMAG: {where}: Mask bit of a frame >= Frame_Count")
-    w, wk = payload[pos + 8], payload[pos + 9]
-    if w > 55:
-        raise KanimError("corrupt", f"IMAG: {where}: Value_Bits {w} > 55")
+    ws, wk = list(payload[pos + 8:pos + 8 + n]), payload[pos + 8 + n]
+    for w in ws:
+        if w > 55:
+            raise KanimError("corrupt", f"IMAG: {where}: Value_Bits {w} > 55")
     if wk > 31:
         raise KanimError("corrupt", f"IMAG: {where}: Context_Bits {wk} > 31")
     m = bin(mask).count("1")
-    nbits = 80 + 4 * wk + wc + (m + 4) * w
+    nbits = head + 4 * wk + sum(wcs) + (m + 4) * sum(ws)
     size = (nbits + 7) // 8
     if pos + size > P:
         raise KanimError("corrupt", f"IMAG: {where} runs past Payload_Size")
     bits = int.from_bytes(payload[pos:pos + size], "little")
     if bits >> nbits:
         raise KanimError("corrupt", f"IMAG: {where}: bits after its last field")
-    fields, p = [], 80
-    for width in [wk] * 4 + [wc] + [w] * (m + 4):
+    fields, p = [], head
+    for width in [wk] * 4 + wcs + [w for w in ws for _ in range(m + 4)]:  # Context, Bases, Values of each
         fields.append((bits >> p) & ((1 << width) - 1))
         p += width
-    ctx, base, values = fields[:4], fields[4], fields[5:]
+    ctx, bases, values = fields[:4], fields[4:4 + n], fields[4 + n:]
     lo, hi = 64 * b, 64 * b + 64
     e = [lo + unzigzag(ctx[0]), lo + unzigzag(ctx[1]), hi + unzigzag(ctx[2]), hi + unzigzag(ctx[3])]
     frames = [lo + t for t in range(64) if mask >> t & 1]
     order = e[:2] + frames + e[2:]  # e_0 < e_1 < the block's keys < e_2 < e_3
     if not all(x < y for x, y in zip(order, order[1:])):
         raise KanimError("corrupt", f"IMAG: {where}: window frames out of order")
-    return {"size": size, "Value_Bits": w, "Context_Bits": wk, "Context": ctx, "Base": base,
-            "Values": values, "frames": frames}
+    return {"size": size, "curves": [{"Value_Bits": ws[k], "Context_Bits": wk, "Context": ctx, "Base": bases[k],
+                                      "Values": values[k * (m + 4):(k + 1) * (m + 4)], "frames": frames}
+                                     for k in range(n)]}
 
 
-def block_curve_keys(a, h):
-    """Every record, block-major, checked against Record_Offset; the block curves' keys
-    (9.3 "The keys of a curve"): {curve: (frames, q, v)}, and the records {curve: [record]}."""
-    payload, offsets, nb, P = a["Payload"], a["Record_Offset"], h["nb"], h["P"]
+def block_curve_keys(a, h, tracks):
+    """Every record, block-major and track after track, checked against Record_Offset; the
+    block curves' keys (9.3 "The keys of a curve"): {curve: (frames, q, v)}, and the records
+    {curve: [record]} (a record of three curves given as each curve's own)."""
+    payload, offsets, nb, nt, P = a["Payload"], a["Record_Offset"], h["nb"], h["nt"], h["P"]
     records = {i: [] for i in range(nb)}
     pos = 0
     for b in range(h["B"]):
-        for i in range(nb):
-            if offsets[b * nb + i] != pos:
-                raise KanimError("corrupt", f"IMAG: Record_Offset[{b * nb + i}]")
-            where = f"record of block {b}, curve {i}"
-            records[i].append(read_record(payload, pos, P, a["Curves"][i][2], b, h["F"], where))
-            pos += records[i][-1]["size"]
+        for t, curves in enumerate(tracks):
+            if offsets[b * nt + t] != pos:
+                raise KanimError("corrupt", f"IMAG: Record_Offset[{b * nt + t}]")
+            where = (f"record of block {b}, curve {curves[0]}" if len(curves) == 1 else
+                     f"record of block {b}, quaternion track {t} (curves {', '.join(map(str, curves))})")
+            record = read_record(payload, pos, P, [a["Curves"][i][2] for i in curves], b, h["F"], where)
+            for i, fields in zip(curves, record["curves"]):
+                records[i].append(fields)
+            pos += record["size"]
     if pos != P:
         raise KanimError("corrupt", "IMAG: the records end before Payload_Size")
     if any(offsets[h["R"]:]) or any(payload[P:]):
@@ -793,14 +1042,19 @@ def block_curve_keys(a, h):
     return keys, records
 
 
-def parse_image(body, F, C, K):
-    """IMAG: every structure rule of 9.4, then each channel's keys (9.3)."""
-    h = image_header(body, F, C)
+def parse_image(body, F, C, K, major, nodes):
+    """IMAG: every structure rule of 9.4, then each channel's keys (9.3). nodes: SKEL's (version
+    5, whose quaternion nodes are checked against them), else None."""
+    h = image_header(body, F, C, len(nodes) if nodes is not None else None, major)
     a = image_arrays(body, h)
-    check_channel_arrays(a, h, K)
+    check_channel_values(a, h, K)
+    # Version 5: the quaternion nodes before the curves' order, which they make (9.2).
+    quats = check_quat_arrays(a, h, nodes)
+    tracks = check_channel_arrays(a, h, quats)
     check_curve_arrays(a, h)
     keys = list_curve_keys(a, h)
-    block_keys, records = block_curve_keys(a, h)
+    check_quat_key_frames(a, h, quats, keys)
+    block_keys, records = block_curve_keys(a, h, tracks)
     keys.update(block_keys)
     frames, values = [], []
     for c in range(C):
@@ -811,8 +1065,8 @@ def parse_image(body, F, C, K):
         else:  # a fixed channel: no key (0 everywhere) or one
             frames.append([a["Fixed_Frame"][c]] if a["Key_Count"][c] else [])
             values.append([a["Fixed_Value"][c]] if a["Key_Count"][c] else [])
-    return {"header": h, "arrays": a, "keys": keys, "records": records, "interp": a["Interpolation"],
-            "tension": a["Tension"], "frames": frames, "values": values}
+    return {"header": h, "arrays": a, "keys": keys, "records": records, "tracks": tracks, "quat_nodes": quats,
+            "interp": a["Interpolation"], "tension": a["Tension"], "frames": frames, "values": values}
 
 
 # ---- IMAG (9.4): the content rules, by rebuilding from the recovered keys.
@@ -876,21 +1130,24 @@ DECOMPRESSED_LIMIT = 1 << 30
 ZSTD_MAX_RATIO = 32768  # section 8: no zstd frame makes more than 32768 bytes of each of its bytes
 
 
+BANK_VERSIONS = (4, 5)  # 10.2: 4.1, and 5.0 for a bank that may hold members of version 5
+
+
 def is_bank(data):
-    """The header says a bank (10.2): the signature, Major_Version 4 and Header_Flags' Bank bit
-    (a version 1-3 file with that bit is a clip file breaking 2.2, refused by parse)."""
-    return (len(data) >= 16 and data[:8] == SIGNATURE and struct.unpack_from("<H", data, 8)[0] == 4
+    """The header says a bank (10.2): the signature, Major_Version 4 or 5 and Header_Flags' Bank
+    bit (a version 1-3 file with that bit is a clip file breaking 2.2, refused by parse)."""
+    return (len(data) >= 16 and data[:8] == SIGNATURE and struct.unpack_from("<H", data, 8)[0] in BANK_VERSIONS
             and bool(struct.unpack_from("<I", data, 12)[0] & BANK))
 
 
 def bank_header(data):
-    """The bank header (10.2): {runtime, minor, clips, skeletons, names_size, dictionary_size}."""
+    """The bank header (10.2): {runtime, major, minor, clips, skeletons, names_size, dictionary_size}."""
     if data[:min(8, len(data))] != SIGNATURE[:min(8, len(data))]:
         raise KanimError("bad_signature", "signature", 0)
     if len(data) < BANK_HEADER_SIZE:
         raise KanimError("truncated", "bank header: the file ends inside its 40 bytes", len(data))
     major, minor, flags, clips, skeletons, names_size, dictionary_size = struct.unpack_from("<HHIIIQQ", data, 8)
-    if major != 4:
+    if major not in BANK_VERSIONS:
         raise KanimError("unsupported_version", f"bank header: major {major}", 8)
     if flags & 0xFFF8:
         raise KanimError("reserved_bits_set", "bank header: Header_Flags bits 3-15", 12)
@@ -900,7 +1157,7 @@ def bank_header(data):
         raise KanimError("corrupt", "bank header: Header_Flags' Member bit is set", 12)
     if flags & 1 and dictionary_size:
         raise KanimError("corrupt", "bank header: a Dictionary_Size with Runtime set", 32)
-    return {"runtime": bool(flags & 1), "minor": minor, "clips": clips, "skeletons": skeletons,
+    return {"runtime": bool(flags & 1), "major": major, "minor": minor, "clips": clips, "skeletons": skeletons,
             "names_size": names_size, "dictionary_size": dictionary_size}
 
 
@@ -1079,7 +1336,7 @@ def open_bank(data):
     check_name_order(order, clips, order_at)
     for s in skeletons:
         s["content"] = skeleton_content(data, s)  # inflated once for all the clips of the skeleton
-    return {"data": data, "runtime": h["runtime"], "version": (4, h["minor"]), "dictionary": dictionary,
+    return {"data": data, "runtime": h["runtime"], "version": (h["major"], h["minor"]), "dictionary": dictionary,
             "skeletons": skeletons, "clips": clips, "order": order}
 
 
@@ -1118,14 +1375,20 @@ def decode_member(bank, i, check_content=True):
                          "is not zero (10.1)", start, (i, c["name"]))
     try:
         major, minor, runtime, count = parse_header(member, member=True)
+        if major > bank["version"][0]:
+            raise KanimError("corrupt", f"header: a member of version {major} in a bank of version "
+                             f"{bank['version'][0]} (10.5)", 8)
         if runtime != bank["runtime"]:
             raise KanimError("corrupt", "header: Runtime differs from the bank's (10.5.1)", 12)
         if runtime:
-            content = runtime_sections(member, count, member=True)
+            content = runtime_sections(member, count, major, member=True)
         else:
-            content = archive_sections(member, count, member=True, dictionary=bank["dictionary"])
+            content = archive_sections(member, count, major, member=True, dictionary=bank["dictionary"])
         content["SKEL"] = skeleton["content"]
-        clip = decode_runtime(content, minor, check_content) if runtime else decode_archive(content, major, minor)
+        if runtime:
+            clip = decode_runtime(content, major, minor, check_content)
+        else:
+            clip = decode_archive(content, major, minor, len(member))
     except KanimError as e:
         # The place: the field's offset in the bank where the member's parse knows it, else
         # the member's first byte (the message names the section).
@@ -1220,13 +1483,24 @@ def positions_for(frame_count):
     return ps
 
 
+def rotations_at(clip, values):
+    """Each quaternion node's rotation (4.7) from the stored values at one position."""
+    return [quat_rotation(q["reference"], *values[q["column"]:q["column"] + 3]) for q in clip["quat_nodes"]]
+
+
 def expected_values(clip, vector, clip_name=None):
     """What a vector's .json holds: the clip's facts and its values at positions_for's
-    positions. vector: the file's name; clip_name: the clip's name in a bank (a "clip" field)."""
+    positions. vector: the file's name; clip_name: the clip's name in a bank (a "clip" field).
+    Version 5 adds the quaternion nodes and, at each position, their rotations (4.7); the
+    values stay the stored ones (a quaternion node's x, y, z, not angles). Earlier versions'
+    JSON has neither field, as before."""
+    v5 = clip["version"][0] >= QUAT_VERSION
     samples = []
     for x in positions_for(clip["frame_count"]):
-        samples.append({"position": x,
-                        "values": [channel_value(clip, c, x) for c in range(len(clip["frames"]))]})
+        values = [channel_value(clip, c, x) for c in range(len(clip["frames"]))]
+        samples.append({"position": x, "values": values})
+        if v5:
+            samples[-1]["rotations"] = rotations_at(clip, values)
     out = {"vector": vector}
     if clip_name is not None:
         out["clip"] = clip_name
@@ -1238,8 +1512,10 @@ def expected_values(clip, vector, clip_name=None):
         "tangent_rule": clip["tangent_rule"],
         "notes": clip["notes"],
         "nodes": clip["nodes"],
-        "samples": samples,
     })
+    if v5:
+        out["quat_nodes"] = [{"node": q["node"], "reference": q["reference"]} for q in clip["quat_nodes"]]
+    out["samples"] = samples
     return out
 
 
@@ -1254,11 +1530,22 @@ def json_text(out):
 
 
 def write_json(path):
+    """Writes the expected values of vector `path` beside it, as NAME.json; returns (its path,
+    "wrote" or "unchanged"). A vector's JSON never changes once published (Appendix C): one
+    that exists with these bytes is left as it is, one with other bytes is an error (KanimError
+    "json_differs"), not overwritten."""
     clip = parse(open(path, "rb").read())
     json_path = os.path.splitext(path)[0] + ".json"
+    text = json_text(expected_values(clip, os.path.basename(path)))
+    if os.path.exists(json_path):
+        with open(json_path, "rb") as fh:
+            if fh.read() == text.encode():
+                return json_path, "unchanged"
+        raise KanimError("json_differs", f"{json_path} exists with other values than this decoder's; a published "
+                         "vector's values never change (remove the file to write it anew)")
     with open(json_path, "w") as fh:
-        fh.write(json_text(expected_values(clip, os.path.basename(path))))
-    return json_path
+        fh.write(text)
+    return json_path, "wrote"
 
 
 def bank_main(path, data, names):
@@ -1304,9 +1591,15 @@ def read_clip(path, name):
 
 def main(argv):
     if len(argv) == 3 and argv[1] == "--write-json":
+        failed = 0
         for p in sorted(glob.glob(os.path.join(argv[2], "*.kanim"))):
-            print(write_json(p))
-        return 0
+            try:
+                json_path, what = write_json(p)
+                print(f"{what}: {json_path}")
+            except KanimError as e:
+                print(f"{p}: {e}", file=sys.stderr)
+                failed = 1
+        return failed
     if len(argv) >= 2 and not argv[1].startswith("--"):
         path, name = split_bank_clip(argv[1])
         try:

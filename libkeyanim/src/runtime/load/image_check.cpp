@@ -160,7 +160,26 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
         at_index<uint32_t>(c, lay, L::tension, ch) != at_index<uint32_t>(c, lay, L::tension, x) ||
         at_index<uint32_t>(c, lay, L::key_count, ch) != at_index<uint32_t>(c, lay, L::key_count, x))
       return fail_in(Status::corrupt, c, lay.at[L::key_count] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
+    if (Status s = check_shared_frames(c, lay, n, ch, x); s != Status::ok) return s;
   }
+  return Status::ok;
+}
+
+// A quaternion node's y or z (channel ch) keys the frames its x (channel x) keys (4.3, 4.4): the
+// same Fixed_Frame, or the same List_Frames (a block track's record has one mask for the three).
+// Called once the curves and lists are checked, with equal Key_Count.
+Status Loader::check_shared_frames(const Content& c, const ImageLayout& lay, const ImageCounts& n, uint64_t ch,
+                                   uint64_t x) {
+  const uint32_t keys = at_index<uint32_t>(c, lay, L::key_count, ch);
+  if (keys == 1 && at_index<uint32_t>(c, lay, L::fixed_frame, ch) != at_index<uint32_t>(c, lay, L::fixed_frame, x))
+    return fail_in(Status::corrupt, c, lay.at[L::fixed_frame] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Fixed_Frame");
+  const uint32_t curve = at_index<uint32_t>(c, lay, L::curve_of, ch), xcurve = at_index<uint32_t>(c, lay, L::curve_of, x);
+  if (keys < 2 || curve < n.block_curves) return Status::ok;
+  const uint64_t j = curve - n.block_curves, xj = xcurve - n.block_curves;
+  const uint32_t first = at_index<uint32_t>(c, lay, L::lists, 2 * j), xfirst = at_index<uint32_t>(c, lay, L::lists, 2 * xj);
+  for (uint32_t e = 0; e < keys; ++e)
+    if (at_index<uint32_t>(c, lay, L::list_frames, first + e) != at_index<uint32_t>(c, lay, L::list_frames, xfirst + e))
+      return fail_in(Status::corrupt, c, lay.at[L::list_frames] + 4 * (uint64_t(first) + e), "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's List_Frames");
   return Status::ok;
 }
 

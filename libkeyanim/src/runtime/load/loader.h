@@ -128,6 +128,7 @@ class Loader {
   Status check_image_curves(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
   Status check_image_quats(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts,
                            const Skeleton& skeleton);
+  Status check_shared_frames(const Content& c, const ImageLayout& lay, const ImageCounts& n, uint64_t ch, uint64_t x);
   Status check_image_records(const Content& c, const ImageLayout& lay, const ImageCounts& n, const ClipSource& parts);
   Status run_runtime(ClipSource& parts);  // run() for the runtime profile
   // A member's skeleton as SKEL's content (MemberContext); else table entry `index`'s.

@@ -98,7 +98,10 @@ Status Loader::read_header_and_table() {
       return fail(Status::corrupt, "table", e.entry_offset, name + ": a bank's member holds no SKEL (its skeleton is the bank's)");
     if (runtime_ && (e.flags & internal::kSectionCompressed))
       return fail(Status::corrupt, "table", e.entry_offset + 4, name + ": no section of the runtime profile is compressed");
-    if (runtime_ && crit == critical_count && e.tag != internal::kTagNote)  // whatever its flags
+    // The archive's critical sections, whatever their flags; QUAT only from version 5 on (before,
+    // an unknown tag: skipped if ancillary, else reserved_bits_set below).
+    const bool known = e.tag != internal::kTagQuat || major >= kQuatFormatVersionMajor;
+    if (runtime_ && crit == critical_count && e.tag != internal::kTagNote && known)
       for (uint32_t tag : internal::kCriticalTagsV5)
         if (tag == e.tag) return fail(Status::corrupt, "table", e.entry_offset, name + ": the runtime profile holds no " + tag_name(tag));
     if (runtime_ && i < critical_count && e.tag != critical_tags[i])
