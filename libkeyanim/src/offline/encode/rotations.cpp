@@ -61,6 +61,16 @@ QuatNode quantized_reference(uint32_t node, const Quat& q) {
   }
 }
 
+// Whether joint's three rotation channels (from its channel `first`) hold one value each over
+// the clip (a still joint, a one-frame pose).
+bool still_rotation(const Motion& m, const Joint& joint, uint32_t first, size_t stride) {
+  const double* row0 = m.values.data() + joint.first_channel + first;
+  for (uint32_t f = 1; f < m.frame_count; ++f)
+    for (uint32_t k = 0; k < 3; ++k)
+      if (row0[size_t(f) * stride + k] != row0[k]) return false;
+  return true;
+}
+
 }  // namespace
 
 std::vector<QuatNode> choose_quat_nodes(const Motion& m) {
@@ -68,7 +78,11 @@ std::vector<QuatNode> choose_quat_nodes(const Motion& m) {
   const size_t stride = m.channel_count();  // once: Motion::frame walks the skeleton
   for (uint32_t j = 0; j < m.skeleton.joints.size(); ++j) {
     const Joint& joint = m.skeleton.joints[j];
-    if (!quaternion_capable(joint) || m.frame_count == 0) continue;
+    uint32_t first = 0;
+    if (!quaternion_capable(joint, &first) || m.frame_count == 0) continue;
+    // A still rotation costs three constants either way; as Euler channels it saves the QUAT
+    // entry (a one-frame pose of 173 joints: 4,592 bytes as quaternions, 4,296 as Euler).
+    if (still_rotation(m, joint, first, stride)) continue;
     // The identity, which costs no bytes, where the rotation stays near the rest pose's
     // (most joints); else the mean of its sign-continuous quaternions (their chordal mean).
     QuatNode n;
