@@ -19,8 +19,10 @@ const char* const kUnpackHelp =
     "-f) or would collide stop the run before any file is written; a damaged clip is reported\n"
     "and skipped, the others written, and the exit code is then 2.\n"
     "  -o, --output DIR      the directory (created if missing)\n"
-    "  --runtime             the runtime profile (format 4.0), sampled in place\n"
-    "  --archive             the archive profile (format 3.0), the smallest\n";
+    "  --runtime             the runtime profile (format 5.0, or 4.0 for Euler clips), sampled\n"
+    "                        in place\n"
+    "  --archive             the archive profile (format 5.0, or 3.0 for Euler clips), the\n"
+    "                        smallest\n";
 
 int cmd_unpack(const Argv& argv, Globals& g) {
   const Args args(argv, {"-o", "--output"}, {"--runtime", "--archive"});
