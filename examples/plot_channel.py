@@ -3,11 +3,14 @@
 marked), and print the encoder's error report.
 
     /usr/bin/python3 examples/plot_channel.py [IN.bvh] [--channel JOINT:CHANNEL] [--error E]
-                                              [-o OUT.png]
+                                              [--rotations euler|quaternion] [-o OUT.png]
 
 Defaults: the CMU walk shipped in data/, its LeftUpLeg:Xrotation, 0.05% of the skeleton size,
-and plot_channel.png in the current directory. Needs the keyanim module (scripts/quickstart.sh
-installs it) and matplotlib (Debian: python3-matplotlib).
+and plot_channel.png in the current directory. Rotations are encoded as Euler channels by
+default (as `keyanim plot` does), so that a rotation channel's keys are its own angles; with
+--rotations quaternion (encode()'s default, format 5.0) a joint's three rotation channels hold
+the x, y, z of its rotation, and the dots mark the decoded angle at its key frames. Needs the
+keyanim module (scripts/quickstart.sh installs it) and matplotlib (Debian: python3-matplotlib).
 """
 
 import argparse
@@ -31,19 +34,23 @@ def main(argv=None):
     p.add_argument("bvh", nargs="?", default=os.path.join(HERE, "..", "data", "cmu_02_01_walk.bvh"))
     p.add_argument("--channel", default="LeftUpLeg:Xrotation", help="JOINT:CHANNEL (default %(default)s)")
     p.add_argument("--error", default="0.05%", help="tolerance, E%% or units (default %(default)s)")
+    p.add_argument("--rotations", default="euler", choices=("euler", "quaternion"),
+                   help="how rotations are encoded (default %(default)s, as `keyanim plot`)")
     p.add_argument("-o", "--output", default="plot_channel.png", help="PNG to write (default %(default)s)")
     args = p.parse_args(argv)
 
     motion = keyanim.read_bvh(args.bvh)
     if args.channel not in motion.channel_names:
         p.error("%s has no channel %s; it has %s" % (args.bvh, args.channel, ", ".join(motion.channel_names)))
-    data, report = keyanim.encode(motion, error=args.error)
+    data, report = keyanim.encode(motion, error=args.error, rotations=args.rotations)
     clip = keyanim.Clip(data)
     c = motion.channel_names.index(args.channel)
 
     frames = np.arange(motion.frame_count)
     fine = np.linspace(0, motion.frame_count - 1, 8 * motion.frame_count)  # in-betweens too
     key_frames, key_values = clip.channel_keys(c)
+    if clip.channel(c)["stored"] != "value":  # a quaternion node's keys hold x, y or z, not degrees:
+        key_values = clip.sample_frames(key_frames.astype(np.float64))[:, c]  # mark the angle there
     fig, ax = plt.subplots(figsize=(10, 4))
     ax.plot(frames, motion.channels[:, c], color="tab:blue", lw=2.5, alpha=0.5, label="original")
     ax.plot(fine, clip.sample_frames(fine)[:, c], color="tab:orange", lw=1, label="decoded")

@@ -108,7 +108,8 @@ class Dataset:
       `stride` frames (default: window, windows that do not overlap). A clip shorter than one
       window gives none.
     output: what dataset[i] returns, one name or a tuple of names (then a tuple of arrays):
-      "channels"            float32 (window, channels): the channel values (angles unwrapped)
+      "channels"            float32 (window, channels): the channel values, as
+                            Clip.sample_frames gives them (see below)
       "local_quaternions"   float32 (window, nodes, 4): local rotations (x, y, z, w)
       "local_translations"  float32 (window, nodes, 3)
       "world_positions"     float32 (window, nodes, 3)
@@ -117,6 +118,15 @@ class Dataset:
     skeleton: None (every clip) or a rig hash (an int, as Clip.rig_hash): only the clips of that
       skeleton, so that every window has one shape. A rig hash names a skeleton whatever file or
       bank it comes from, and stays valid across datasets and pickling.
+
+    Channels: a BVH file's angles are unwrapped (consecutive frames differ by less than 180
+    degrees), as are those of .kanim clips encoded with rotations='euler'. A joint that the
+    encoder stored as a quaternion node (format 5.0, encode()'s default: Clip.quat_nodes) has
+    its rotation channels' Euler angles computed from its rotation, continuous within a window
+    (Clip.sample_frames(..., continuous=True): each frame's angles nearest the frame before's,
+    as Clip.to_motion() and a BVH file have them); a window's first frame has the middle angle
+    in [-90, 90], so two windows may start on different (equivalent) angles. To learn
+    rotations, "local_quaternions" are continuous for every joint.
 
     len(dataset) counts the windows; dataset[i] samples only the window's frames of one clip
     (the GIL released), never a whole clip. `clips`, `paths` (the file of each clip; a bank's
@@ -212,7 +222,7 @@ class Dataset:
         out = {}
         for name in self._names:
             if name == "channels":
-                out[name] = clip.sample_frames(at)
+                out[name] = clip.sample_frames(at, continuous=True)
             elif name == "world_positions":
                 out[name] = clip.world_positions(frames=at, position_channels=self._reading)
             elif name not in out:

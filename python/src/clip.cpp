@@ -104,14 +104,78 @@ Positions where(const PyClip& c, const py::handle& times, const py::handle& fram
   return p;
 }
 
-py::array_t<float> sample(const PyClip& c, const Positions& p) {
+// Each quaternion node's Euler angles in rows [1, n) of every run of n rows (the positions'
+// last axis) moved to the solution nearest the row before (nearest_euler): continuous along the
+// positions, as to_motion()'s frames are.
+void make_continuous(const Clip& clip, float* data, size_t rows, size_t n) {
+  const size_t width = clip.channel_count();
+  for (uint32_t q = 0; q < clip.quat_node_count(); ++q) {
+    const Joint& joint = clip.skeleton().joints.at(clip.quat_node(q).node);
+    uint32_t first = 0;
+    quaternion_capable(joint, &first);  // (the loader checked that it is)
+    const size_t column = joint.first_channel + first;
+    for (size_t i = 0; i < rows; ++i) {
+      if (i % n == 0) continue;
+      float* row = data + i * width + column;
+      const float* before = row - width;
+      const double previous[3] = {before[0], before[1], before[2]};
+      double deg[3] = {row[0], row[1], row[2]};
+      nearest_euler(previous, deg);
+      for (int k = 0; k < 3; ++k) row[k] = static_cast<float>(deg[k]);
+    }
+  }
+}
+
+// Every channel at every position: the channels' values (a quaternion node's rotation channels
+// as Euler angles, with `continuous` each nearest the position's before), or with `stored`
+// what the keys interpolate (its stored x, y, z).
+py::array_t<float> sample(const PyClip& c, const Positions& p, bool stored = false, bool continuous = false) {
   const size_t width = c.clip.channel_count();
   py::array_t<float> out(shape_with(p.shape, {py::ssize_t(width)}));
   float* data = out.mutable_data();
   py::gil_scoped_release unlocked;
   Cursor cursor;
   if (cursor.prepare(c.clip) != Status::ok) throw std::bad_alloc();
-  for (size_t i = 0; i < p.values.size(); ++i) c.clip.sample(p.values[i], {data + i * width, width}, &cursor);
+  for (size_t i = 0; i < p.values.size(); ++i) {
+    if (stored) c.clip.sample_stored(p.values[i], {data + i * width, width}, &cursor);
+    else c.clip.sample(p.values[i], {data + i * width, width}, &cursor);
+  }
+  const size_t run = p.shape.empty() ? 1 : size_t(std::max<py::ssize_t>(p.shape.back(), 1));
+  if (continuous && !stored) make_continuous(c.clip, data, p.values.size(), run);
+  return out;
+}
+
+// What channel(c)["stored"] says a channel's keys hold.
+const char* stored_name(StoredAs stored) {
+  switch (stored) {
+    case StoredAs::quat_x: return "quat_x";
+    case StoredAs::quat_y: return "quat_y";
+    case StoredAs::quat_z: return "quat_z";
+    case StoredAs::value: break;
+  }
+  return "value";
+}
+
+// Clip.quat_nodes: one dict per quaternion node, in node order.
+py::list quat_nodes(const PyClip& c) {
+  py::list out;
+  const Skeleton& s = c.clip.skeleton();
+  for (uint32_t i = 0; i < c.clip.quat_node_count(); ++i) {
+    const QuatNode n = c.clip.quat_node(i);
+    const Joint& joint = s.joints.at(n.node);
+    uint32_t first = 0;
+    quaternion_capable(joint, &first);  // (the loader checked that it is)
+    double q[4];
+    reference_of(n, q);
+    py::dict d;
+    d["node"] = n.node;
+    d["joint"] = text(offline::node_name(s, n.node));
+    const uint32_t column = joint.first_channel + first;
+    d["channels"] = py::make_tuple(column, column + 1, column + 2);
+    d["reference"] = py::make_tuple(n.reference[0], n.reference[1], n.reference[2]);
+    d["reference_quaternion"] = py::make_tuple(q[0], q[1], q[2], q[3]);
+    out.append(d);
+  }
   return out;
 }
 
@@ -151,7 +215,13 @@ const char* const kClipDoc =
     "keyanim.Error with its section and byte offset), sampled at any time or frame position.\n"
     "Values between frames come from the clip's curves. Sampling many positions at once releases\n"
     "the GIL, so threads sampling clips run in parallel. Nodes are the joints and End Sites in\n"
-    "file order.";
+    "file order.\n\n"
+    "Quaternion nodes (format 5.0, what encode() writes by default; see quat_nodes): a joint's\n"
+    "three rotation channels may hold the x, y, z of its rotation relative to a reference\n"
+    "rotation, rather than its Euler angles. sample() and sample_frames() still give every\n"
+    "channel's Euler angle in degrees (computed from the rotation at each position, the middle\n"
+    "angle in [-90, 90]); sample_stored() and channel_keys() give the stored x, y, z, and\n"
+    "channel(c)['stored'] says which a channel holds.";
 
 }  // namespace
 
@@ -211,8 +281,8 @@ void register_clip(py::module_& m) {
         }
         return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
       },
-      "The clip as a runtime-profile .kanim (format 4.0), which samples to the same values bit for\n"
-      "bit: what `keyanim convert --runtime` writes.");
+      "The clip as a runtime-profile .kanim (format 5.0 with quaternion nodes, else 4.0), which\n"
+      "samples to the same values bit for bit: what `keyanim convert --runtime` writes.");
   cls.def(
       "archive_bytes",
       [](const PyClip& c) {
@@ -223,8 +293,9 @@ void register_clip(py::module_& m) {
         }
         return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
       },
-      "The clip as an archive-profile .kanim (format 3.0): `keyanim convert --archive`. The same\n"
-      "keys and values; a constant channel's single key is stored as +-1 x |value|.");
+      "The clip as an archive-profile .kanim (format 5.0 with quaternion nodes, else 3.0):\n"
+      "`keyanim convert --archive`. The same keys and values; a constant channel's single key is\n"
+      "stored as +-1 x |value|.");
   cls.def_property_readonly("frame_time", [](const PyClip& c) { return c.clip.frame_time(); }, "Seconds between frames.");
   cls.def_property_readonly("fps", [](const PyClip& c) { return fps_of(c.clip.frame_time()); },
                             "Frames per second, 1 / frame_time (None without a frame time).");
@@ -260,17 +331,49 @@ void register_clip(py::module_& m) {
       "A dict with the keys of `keyanim info --json` (version, frames, frame_time, joints,\n"
       "channels, size, keys per channel, tensions, memory_bytes, encoder_notes, ...).");
   cls.def(
-      "sample", [](const PyClip& c, const py::object& times) { return sample(c, where(c, times, py::none())); },
-      py::arg("times"),
+      "sample",
+      [](const PyClip& c, const py::object& times, bool continuous) {
+        return sample(c, where(c, times, py::none()), false, continuous);
+      },
+      py::arg("times"), py::kw_only(), py::arg("continuous") = false,
       "Every channel at each time in seconds: float32 array times.shape + (channels,). Times\n"
       "are 0 to duration (others raise keyanim.Error naming them, as `keyanim sample --time`\n"
-      "refuses them); between frames the values are in-betweens.");
+      "refuses them); between frames the values are in-betweens. A quaternion node's rotation\n"
+      "channels give the Euler angles (degrees, in its channels' order) of its rotation at each\n"
+      "time, computed time by time with the middle angle in [-90, 90]: not continuous across a\n"
+      "wrap, unlike to_motion()'s (use local_transforms for rotations to learn or blend). With\n"
+      "continuous=True, along the last axis of times each position's angles are those of the same\n"
+      "rotation nearest the position's before (the other Euler solution, whole turns), as\n"
+      "to_motion() chooses them: continuous as a BVH file's channels; the first as without.");
   cls.def(
-      "sample_frames", [](const PyClip& c, const py::object& frames) { return sample(c, where(c, py::none(), frames)); },
-      py::arg("frames"),
+      "sample_frames",
+      [](const PyClip& c, const py::object& frames, bool continuous) {
+        return sample(c, where(c, py::none(), frames), false, continuous);
+      },
+      py::arg("frames"), py::kw_only(), py::arg("continuous") = false,
       "Every channel at each frame position (fractional positions are in-betweens): float32\n"
       "array frames.shape + (channels,). Positions are 0 to frame_count - 1; others raise\n"
-      "keyanim.Error naming them (as in local_transforms and world_positions).");
+      "keyanim.Error naming them (as in local_transforms and world_positions). A quaternion\n"
+      "node's rotation channels give Euler angles, as sample() does (continuous= too).");
+  cls.def(
+      "sample_stored",
+      [](const PyClip& c, const py::object& frames) { return sample(c, where(c, py::none(), frames), true); },
+      py::arg("frames"),
+      "sample_frames(frames), but with what the keys hold: a quaternion node's rotation channels\n"
+      "give its stored x, y, z (channel(c)['stored'] is 'quat_x', 'quat_y', 'quat_z'; the\n"
+      "rotation relative to the node's reference, w = sqrt(max(0, 1 - x^2 - y^2 - z^2))), every\n"
+      "other channel the same value as sample_frames. These are the curves through\n"
+      "channel_keys() (spec/FORMAT.md Appendix A): equal to the keys' values at the key frames.");
+  cls.def_property_readonly(
+      "quat_nodes", &quat_nodes,
+      "The nodes whose rotation is stored as a quaternion (format 5.0: encode(rotations=\n"
+      "'quaternion'), the default), in node order; [] for a clip of Euler channels only. One dict\n"
+      "each: node (index into joint_names), joint (its name), channels (the indices of its three\n"
+      "rotation channels, which hold x, y, z in that order, whatever their axes), reference (the\n"
+      "reference rotation's x, y, z as stored: ints in units of 2^-15, w rebuilt >= 0) and\n"
+      "reference_quaternion (the same as a unit quaternion (x, y, z, w), float64). The node's\n"
+      "rotation at a position is reference_quaternion * (x, y, z, w), normalized, with x, y, z from\n"
+      "sample_stored and w = sqrt(max(0, 1 - x^2 - y^2 - z^2)).");
   cls.def(
       "local_transforms",
       [](const PyClip& c, const py::object& times, const py::object& frames, const std::string& reading) {
@@ -303,11 +406,14 @@ void register_clip(py::module_& m) {
         d["interpolation"] = info.interp == Interpolation::linear ? "linear" : "cardinal";
         d["tension"] = info.tension;
         d["key_count"] = info.key_count;
+        d["stored"] = stored_name(info.stored);
         return d;
       },
       py::arg("channel"),
       "How one channel (index into channel_names) is stored: a dict with interpolation\n"
-      "('cardinal' or 'linear'), tension (in [-1, 1]; 0 is Catmull-Rom) and key_count.");
+      "('cardinal' or 'linear'), tension (in [-1, 1]; 0 is Catmull-Rom), key_count and stored:\n"
+      "what its keys hold, 'value' (the channel's own value: a position, or an Euler angle in\n"
+      "degrees) or 'quat_x', 'quat_y', 'quat_z' (a quaternion node's stored x, y or z: quat_nodes).");
   cls.def(
       "channel_keys",
       [](const PyClip& c, int64_t index) {
@@ -320,7 +426,9 @@ void register_clip(py::module_& m) {
       },
       py::arg("channel"),
       "The keys of one channel (index into channel_names): frames (uint32) and values (float32),\n"
-      "exactly as the sampler uses them. No keys: the channel is 0 throughout; one: constant.");
+      "exactly as the sampler uses them. No keys: the channel is 0 throughout; one: constant.\n"
+      "The values are what channel(c)['stored'] says: a quaternion node's stored x, y or z (not\n"
+      "degrees; sample_stored() interpolates them), else the channel's own values.");
   cls.def(
       "frame_count_at",
       [](const PyClip& c, const py::object& fps) -> uint64_t {
@@ -356,7 +464,12 @@ void register_clip(py::module_& m) {
       [](const PyClip& c, const py::object& fps) { return clip_to_motion(c.clip, fps); },
       py::arg("fps") = py::none(),
       "Decodes the clip to a Motion: at the source frames (fps=None), or at frames every 1/fps\n"
-      "seconds from the start up to the end (motion tweening: the in-betweens come from the curves).");
+      "seconds from the start up to the end (motion tweening: the in-betweens come from the curves),\n"
+      "as `keyanim decode` does. Channels stored as values are sample_frames()'s at those\n"
+      "positions; a quaternion node's rotation channels are Euler angles computed in float64, each\n"
+      "frame's chosen nearest the frame before (continuous, as a BVH file's): the same rotations\n"
+      "as sample_frames() gives (to about 1e-6 radians), but possibly other angles for them (by\n"
+      "whole turns, or the other Euler triple).");
   cls.def("__repr__", [](const PyClip& c) {
     return "<keyanim.Clip: " + std::to_string(c.clip.frame_count()) + " frames, " +
            std::to_string(c.clip.skeleton().joints.size()) + " nodes, " + std::to_string(c.clip.channel_count()) +

@@ -85,13 +85,21 @@ void set_other(const py::kwargs& kwargs, offline::EncodeSettings& s) {
       if (rule == "step_adjusted") s.tangent_rule = TangentRule::step_adjusted;
       else if (rule == "uniform") s.tangent_rule = TangentRule::uniform;
       else invalid("tangent_rule must be 'step_adjusted' or 'uniform', got '" + rule + "'");
+    } else if (name == "rotations") {
+      if (!py::isinstance<py::str>(value))
+        throw py::type_error("rotations must be 'quaternion' or 'euler' (a str), got " + std::string(py::repr(value)));
+      const std::string form = value.cast<std::string>();
+      if (form == "quaternion") s.rotations = offline::Rotations::quaternion;
+      else if (form == "euler") s.rotations = offline::Rotations::euler;
+      else invalid("rotations must be 'quaternion' or 'euler', got '" + form + "'");
     } else if (name == "allow_linear") {
       s.allow_linear = value.cast<bool>();
     } else if (name == "force_linear") {
       s.force_linear = value.cast<bool>();
     } else {
       throw py::type_error("encode() got an unexpected keyword argument '" + name +
-                           "' (settings: shell, tension, level, threads, tangent_rule, allow_linear, force_linear)");
+                           "' (settings: shell, tension, level, threads, tangent_rule, rotations, allow_linear, "
+                           "force_linear)");
     }
   }
   s.validate();
@@ -154,9 +162,17 @@ void register_encode(py::module_& m) {
         "  and End Sites only), tension (in [-1, 1], default 0, or 'fit'), level (zstd, 1..22, on\n"
         "  every section; default: each section at its measured parameters), threads (default 0:\n"
         "  one per core; the bytes do not depend on it),\n"
-        "  tangent_rule ('step_adjusted' or 'uniform'), allow_linear (default True), force_linear\n"
-        "  (False). A motion with position channels below the root is kept within error under both\n"
-        "  readings of them (replace and add).\n\n"
+        "  tangent_rule ('step_adjusted' or 'uniform'), rotations (as --rotations, below),\n"
+        "  allow_linear (default True), force_linear (False). A motion with position channels below\n"
+        "  the root is kept within error under both readings of them (replace and add).\n"
+        "rotations: 'quaternion' (the default) stores each joint with three consecutive rotation\n"
+        "  channels about three axes whose rotation moves, and stays within 145 degrees of one\n"
+        "  reference, as the x, y, z of its rotation relative to that reference, on key frames the\n"
+        "  three share: a format 5.0 file (fewer bytes; Clip.quat_nodes lists those joints, their\n"
+        "  channels' keys are the stored x, y, z, and sampling still gives Euler angles). 'euler'\n"
+        "  keeps every rotation as its Euler channels, keyed one by one: a format 3.0 file, which\n"
+        "  decoders of formats 3 and 4 read, its keys the BVH's own angles. As `keyanim encode\n"
+        "  --rotations`; anything else is keyanim.Error.\n\n"
         "Releases the GIL while encoding. Raises keyanim.Error for settings that make no sense or a\n"
         "motion the codec cannot store.");
 }

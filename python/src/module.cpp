@@ -8,8 +8,10 @@ PYBIND11_MODULE(_keyanim, m) {
   using namespace keyanim::python;
   m.doc() = "keyanim: skeletal motion stored as keyframes, rebuilt by Cardinal splines.";
   m.attr("__version__") = KEYANIM_VERSION_STRING;
-  m.attr("format_version") = std::to_string(keyanim::kFormatVersionMajor) + "." +
-                             std::to_string(keyanim::kFormatVersionMinor);
+  // The version encode() writes by default (rotations as quaternion curves), as
+  // keyanim_format_version() says; encode(rotations='euler') writes 3.0, which older decoders read.
+  m.attr("format_version") = std::to_string(keyanim::kQuatFormatVersionMajor) + "." +
+                             std::to_string(keyanim::kQuatFormatVersionMinor);
   register_errors(m);
   register_motion(m);
   register_encode(m);

@@ -221,6 +221,89 @@ def quaternion_matrices(q):
     ], -2)
 
 
+# ---- Quaternions, independently of keyanim (x, y, z, w; spec/FORMAT.md 4.7 and Appendix B):
+# the rotation of a quaternion node from its stored x, y, z, and of Euler angles.
+
+def hamilton(a, b):
+    """The Hamilton product a b of (..., 4) quaternions (x, y, z, w)."""
+    ax, ay, az, aw = np.moveaxis(np.asarray(a, dtype=np.float64), -1, 0)
+    bx, by, bz, bw = np.moveaxis(np.asarray(b, dtype=np.float64), -1, 0)
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw,
+                     aw * bw - ax * bx - ay * by - az * bz], -1)
+
+
+def euler_quaternions(degrees, axes):
+    """(..., 3) angles in degrees about `axes` ('ZYX': the channels' axes in their order) ->
+    (..., 4) unit quaternions of R = R_axes[0] R_axes[1] R_axes[2], as local_rotations composes
+    them."""
+    degrees = np.asarray(degrees, dtype=np.float64)
+    q = np.zeros(degrees.shape[:-1] + (4,))
+    q[..., 3] = 1.0
+    for k, axis in enumerate(axes):
+        half = np.radians(degrees[..., k]) / 2
+        turn = np.zeros(degrees.shape[:-1] + (4,))
+        turn[..., "XYZ".index(axis.upper())] = np.sin(half)
+        turn[..., 3] = np.cos(half)
+        q = hamilton(q, turn)
+    return q
+
+
+def stored_quaternions(reference, xyz):
+    """4.7: a quaternion node's rotation from its stored (..., 3) x, y, z and its reference (x, y,
+    z, w): reference (x, y, z, sqrt(max(0, 1 - x^2 - y^2 - z^2))), normalized."""
+    xyz = np.asarray(xyz, dtype=np.float64)
+    w = np.sqrt(np.maximum(0.0, 1.0 - np.sum(xyz * xyz, axis=-1)))
+    q = hamilton(np.broadcast_to(np.asarray(reference, dtype=np.float64), xyz.shape[:-1] + (4,)),
+                 np.concatenate([xyz, w[..., None]], axis=-1))
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def rotation_angles(a, b):
+    """The angle in radians of the rotation between unit quaternions a and b (..., 4), whatever
+    their signs (q and -q are one rotation): 2 atan2(|v|, |w|) of conj(a) b."""
+    conj = np.asarray(a, dtype=np.float64) * np.array([-1.0, -1.0, -1.0, 1.0])
+    d = hamilton(conj, b)
+    return 2.0 * np.arctan2(np.linalg.norm(d[..., :3], axis=-1), np.abs(d[..., 3]))
+
+
+def quat_axes(clip, node):
+    """The axes of a quaternion node's rotation channels in their order: 'ZYX' for the CMU
+    joints."""
+    return "".join(clip.channel_names[c].rsplit(":", 1)[1][0] for c in node["channels"])
+
+
+def euler_channels(clip):
+    """The channels whose values are their keys' (channel(c)['stored'] == 'value'): positions,
+    and the Euler angles of nodes that are not quaternion nodes."""
+    return [c for c in range(clip.channel_count) if clip.channel(c)["stored"] == "value"]
+
+
+def assert_same_rotations(clip, a, b, bound=1e-5):
+    """(frames, channels) values a and b of `clip`: every quaternion node's three rotation
+    channels compose, as Euler angles, to the same rotation within `bound` radians."""
+    for node in clip.quat_nodes:
+        c, axes = list(node["channels"]), quat_axes(clip, node)
+        angle = rotation_angles(euler_quaternions(a[..., c], axes), euler_quaternions(b[..., c], axes))
+        assert angle.max() <= bound, (node["joint"], angle.max())
+
+
+def assert_decoded_is_sampled(clip, decoded, sampled):
+    """A Motion's channels decoded from `clip` (Clip.to_motion, float64) against sample_frames at
+    the same positions (float32): channels stored as values bit for bit (the decoder's values are
+    the sampler's); a quaternion node's, Euler angles of the same rotation (the decoder computes
+    them in float64 and keeps them continuous from frame to frame, the sampler position by
+    position), each angle within 180 degrees of the frame before."""
+    assert decoded.dtype == np.float64 and sampled.dtype == np.float32 and decoded.shape == sampled.shape
+    values = euler_channels(clip)
+    assert np.array_equal(decoded[..., values], sampled[..., values].astype(np.float64))
+    assert_same_rotations(clip, decoded, sampled)
+    for node in clip.quat_nodes:
+        steps = np.abs(np.diff(decoded[:, list(node["channels"])], axis=0))
+        assert steps.size == 0 or steps.max() <= 180.0, node["joint"]
+
+
 def skeleton_size(bvh):
     """Largest side of the rest pose's bounding box (OFFSETs alone)."""
     rest = np.zeros_like(bvh.offsets)
@@ -253,6 +336,17 @@ def walk_encoded(keyanim, walk):
 @pytest.fixture(scope="session")
 def walk_clip(keyanim, walk_encoded):
     return keyanim.Clip(walk_encoded[0])
+
+
+@pytest.fixture(scope="session")
+def walk_euler_encoded(keyanim, walk):
+    """The walk encoded with every rotation as its Euler channels (a 3.0 file)."""
+    return keyanim.encode(walk, rotations="euler")
+
+
+@pytest.fixture(scope="session")
+def walk_euler_clip(keyanim, walk_euler_encoded):
+    return keyanim.Clip(walk_euler_encoded[0])
 
 
 @pytest.fixture

@@ -74,8 +74,13 @@ def read_index(path):
         entries.append(dict(name=b[pool + name_offset:pool + name_offset + name_size], offset=offset, size=size,
                             frame_time=frame_time, frames=frames, skeleton=skeleton))
     order = struct.unpack_from("<%dI" % clips, b, table + 40 * clips)
-    return dict(major=major, flags=flags, clips=clips, skeletons=skeletons, dictionary=dictionary,
+    return dict(major=major, minor=minor, flags=flags, clips=clips, skeletons=skeletons, dictionary=dictionary,
                 entries=entries, order=order)
+
+
+def bank_version(clips):
+    """Section 10.2: a bank holding a clip with quaternion nodes (format 5.0) is 5.0, else 4.1."""
+    return (5, 0) if any(clip.quat_nodes for clip in clips) else (4, 1)
 
 
 def same_bits(a, b):
@@ -85,7 +90,10 @@ def same_bits(a, b):
 def test_the_index_as_the_spec_lays_it_out(library):
     for path, runtime in ((library["archive"], False), (library["runtime"], True)):
         bank, index = keyanim.Bank(path), read_index(path)
-        assert index["major"] == 4 and index["flags"] & 4 and bool(index["flags"] & 1) == runtime
+        members = [keyanim.Clip(p) for p in library["files"].values()]
+        assert bank_version(members) == (5, 0)  # encode()'s default stores quaternion nodes
+        assert (index["major"], index["minor"]) == bank_version(members)
+        assert index["flags"] & 4 and bool(index["flags"] & 1) == runtime
         assert len(bank) == index["clips"] == 5 and bank.skeleton_count == index["skeletons"] == 3
         assert bank.profile == ("runtime" if runtime else "archive")
         assert bank.names == library["names"] == list(bank)
@@ -106,6 +114,36 @@ def test_the_index_as_the_spec_lays_it_out(library):
             assert name in bank
         skeleton = [e["skeleton"] for e in bank.entries]
         assert skeleton[0] == skeleton[1] == skeleton[4] != skeleton[2] != skeleton[3] != skeleton[0]
+
+
+@pytest.mark.parametrize("runtime", [False, True])
+def test_a_bank_of_euler_clips_is_4_1(library, tmp_path, runtime):
+    """Clips encoded with rotations='euler' make a 4.1 bank, which decoders of 4.1 read; one
+    clip with quaternion nodes among them makes it 5.0."""
+    walk, hop = keyanim.read_bvh(WALK), keyanim.read_bvh(HOP)
+    euler = {"walk": keyanim.Clip(keyanim.encode(walk, error="0.5%", rotations="euler")[0]),
+             "hop": keyanim.Clip(keyanim.encode(hop, error="0.5%", rotations="euler")[0])}
+    assert bank_version(euler.values()) == (4, 1)
+    keyanim.write_bank(tmp_path / "euler.kbank", euler, runtime=runtime)
+    index = read_index(tmp_path / "euler.kbank")
+    assert (index["major"], index["minor"]) == (4, 1) and bool(index["flags"] & 1) == runtime
+    bank = keyanim.Bank(tmp_path / "euler.kbank")
+    for name, clip in euler.items():
+        member = bank.clip(name)
+        assert member.quat_nodes == [] and member.info["version"] == "4.1"  # a member of version 4 (10.5)
+        frames = np.linspace(0, clip.frame_count - 1, 3 * clip.frame_count)
+        assert same_bits(member.sample_frames(frames), clip.sample_frames(frames))
+    mixed = dict(euler, quat=keyanim.Clip(library["files"]["hop"]))
+    assert mixed["quat"].quat_nodes and bank_version(mixed.values()) == (5, 0)
+    keyanim.write_bank(tmp_path / "mixed.kbank", mixed, runtime=runtime)
+    index = read_index(tmp_path / "mixed.kbank")
+    assert (index["major"], index["minor"]) == (5, 0)
+    bank = keyanim.Bank(tmp_path / "mixed.kbank")
+    assert bank.clip("quat").quat_nodes == mixed["quat"].quat_nodes and bank.clip("walk").quat_nodes == []
+    # A member has a version of its own (10.5): 5.0 with quaternion nodes, else 4.1.
+    assert bank.clip("quat").info["version"] == "5.0" and bank.clip("walk").info["version"] == "4.1"
+    frames = np.linspace(0, euler["walk"].frame_count - 1, 1000)
+    assert same_bits(bank.clip("walk").sample_frames(frames), euler["walk"].sample_frames(frames))
 
 
 def test_write_bank_reports_what_it_wrote(library):
@@ -130,7 +168,10 @@ def test_every_clip_equals_its_own_file(library, which):
         assert same_bits(member.sample_frames(frames), alone.sample_frames(frames))
         for x, y in zip(member.local_transforms(frames=frames[::7]), alone.local_transforms(frames=frames[::7])):
             assert same_bits(x, y)
+        assert same_bits(member.sample_stored(frames), alone.sample_stored(frames))
+        assert member.quat_nodes == alone.quat_nodes
         for c in range(0, alone.channel_count, 5):
+            assert member.channel(c) == alone.channel(c)
             for x, y in zip(member.channel_keys(c), alone.channel_keys(c)):
                 assert np.array_equal(x, y)
         m, want = bank.to_motion(name, fps=30), alone.to_motion(fps=30)
@@ -349,7 +390,7 @@ def test_dataset_over_a_folder_of_banks_and_files(library, tmp_path):
     assert all(c.profile == "runtime" for c in ds.clips[:5])
     walk = keyanim.Clip(library["files"]["walk"])
     assert ds.clips[0].rig_hash == walk.rig_hash == ds.clips[5].rig_hash  # one skeleton, from a bank and a BVH
-    assert same_bits(ds[0], walk.sample_frames(np.arange(64.0)))
+    assert same_bits(ds[0], walk.sample_frames(np.arange(64.0), continuous=True))
 
 
 @pytest.mark.corpus

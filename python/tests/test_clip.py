@@ -9,8 +9,9 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import (HOP, WALK, cli, cli_json, corpus_files, frames_at_rate, local_rotations, local_translations,
-                      parse_bvh, quaternion_matrices, world_positions)
+from conftest import (HOP, WALK, assert_decoded_is_sampled, cli, cli_json, corpus_files, euler_quaternions,
+                      frames_at_rate, local_rotations, local_translations, parse_bvh, quat_axes, quaternion_matrices,
+                      rotation_angles, stored_quaternions, world_positions)
 
 F = np.float32
 
@@ -84,19 +85,68 @@ def test_skeleton_properties_are_the_motions(walk, walk_clip):
     assert np.array_equal(walk_clip.is_end_site, walk.is_end_site)
 
 
-def test_sampling_is_appendix_a(walk_clip):
-    rule = walk_clip.info["tangent_rule"]
-    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343])
-    got = walk_clip.sample_frames(positions)
-    assert got.dtype == np.float32 and got.shape == (8, 96)
-    for c in range(walk_clip.channel_count):
-        info = walk_clip.channel(c)
-        frames, values = walk_clip.channel_keys(c)
+def check_appendix_a(clip, positions):
+    """Appendix A on what every channel's keys hold (sample_stored), bit for bit; sample_frames
+    gives the same for channels stored as values. Returns (sample_frames, sample_stored)."""
+    rule = clip.info["tangent_rule"]
+    got, stored = clip.sample_frames(positions), clip.sample_stored(positions)
+    assert got.dtype == stored.dtype == np.float32 and got.shape == stored.shape == (len(positions), clip.channel_count)
+    for c in range(clip.channel_count):
+        info = clip.channel(c)
+        frames, values = clip.channel_keys(c)
         assert len(frames) == info["key_count"] and frames.dtype == np.uint32 and values.dtype == np.float32
         want = [appendix_a(frames, values, info["interpolation"], info["tension"], rule, x) for x in positions]
-        assert np.array_equal(got[:, c], np.array(want, dtype=F)), walk_clip.channel_names[c]
-        # At its keys a channel is its keys' values exactly.
-        assert np.array_equal(walk_clip.sample_frames(frames.astype(np.float64))[:, c], values)
+        assert np.array_equal(stored[:, c], np.array(want, dtype=F)), clip.channel_names[c]
+        # At its keys a channel holds its keys' values exactly.
+        assert np.array_equal(clip.sample_stored(frames.astype(np.float64))[:, c], values)
+        if info["stored"] == "value":
+            assert np.array_equal(got[:, c], stored[:, c]), clip.channel_names[c]
+            assert np.array_equal(clip.sample_frames(frames.astype(np.float64))[:, c], values)
+        else:
+            assert info["stored"] in ("quat_x", "quat_y", "quat_z")
+    return got, stored
+
+
+def check_quat_nodes(clip, positions):
+    """4.7 and Appendix B: each quaternion node's rotation channels hold stored x, y, z (in that
+    order, on shared key frames), and sample_frames gives the Euler angles (middle one in
+    [-90, 90]) of the rotation reference * (x, y, z, w), normalized, computed here in numpy."""
+    got, stored = clip.sample_frames(positions), clip.sample_stored(positions)
+    seen = set()
+    for node in clip.quat_nodes:
+        c = list(node["channels"])
+        assert c == [c[0], c[0] + 1, c[0] + 2] and sorted(quat_axes(clip, node)) == ["X", "Y", "Z"]
+        assert clip.joint_names[node["node"]] == node["joint"]
+        assert all(clip.channel_names[k].rsplit(":", 1)[0] == node["joint"] for k in c)
+        assert [clip.channel(k)["stored"] for k in c] == ["quat_x", "quat_y", "quat_z"]
+        key_frames = [clip.channel_keys(k)[0] for k in c]
+        assert np.array_equal(key_frames[0], key_frames[1]) and np.array_equal(key_frames[0], key_frames[2])
+        X, Y, Z = node["reference"]
+        assert all(isinstance(v, int) and -32768 <= v < 32768 for v in (X, Y, Z)) and X * X + Y * Y + Z * Z <= 2 ** 30
+        reference = np.array([X, Y, Z, np.sqrt(2.0 ** 30 - (X * X + Y * Y + Z * Z))]) * 2.0 ** -15
+        np.testing.assert_allclose(node["reference_quaternion"], reference, rtol=0, atol=1e-15)
+        rotation = stored_quaternions(reference, stored[:, c])
+        angles = rotation_angles(euler_quaternions(got[:, c], quat_axes(clip, node)), rotation)
+        assert angles.max() <= 1e-5, (node["joint"], angles.max())
+        assert (np.abs(got[:, c[1]]) <= 90).all() and (np.abs(got[:, c]) <= 180).all(), node["joint"]
+        seen.update(c)
+    assert seen == {c for c in range(clip.channel_count) if clip.channel(c)["stored"] != "value"}
+
+
+def test_sampling_is_appendix_a(walk_clip):
+    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343])
+    check_appendix_a(walk_clip, positions)
+    assert len(walk_clip.quat_nodes) == 27  # the default encoding: each joint of three rotation channels
+    check_quat_nodes(walk_clip, np.concatenate([positions, np.arange(0.0, 343.25, 0.25)]))
+
+
+def test_an_euler_clip_samples_its_keys(walk_euler_clip):
+    """rotations='euler': no quaternion node, every channel's keys its own values (degrees)."""
+    assert walk_euler_clip.quat_nodes == [] and walk_euler_clip.info["version"] == "3.0"
+    assert {walk_euler_clip.channel(c)["stored"] for c in range(96)} == {"value"}
+    positions = np.array([0, 0.3, 1, 17.25, 100.5, 200.125, 342.9, 343])
+    got, stored = check_appendix_a(walk_euler_clip, positions)
+    assert np.array_equal(got, stored)
 
 
 def test_times_and_frames_agree(walk_clip):
@@ -158,13 +208,26 @@ def test_info_is_the_tools(walk_clip, walk_encoded, tmp_path):
     in_memory = walk_clip.info
     assert in_memory["file"] is None and {k: v for k, v in in_memory.items() if k != "file"} == \
         {k: v for k, v in from_file.items() if k != "file"}
-    assert in_memory["format"] == "kanim" and in_memory["version"] == keyanim.format_version
+    # The default encoding writes quaternion nodes: format 5.0, the module's format_version.
+    assert in_memory["format"] == "kanim" and in_memory["version"] == keyanim.format_version == "5.0"
+    assert walk_clip.quat_nodes
 
 
-def test_to_motion(keyanim, walk_clip, walk_encoded, tmp_path):
+def test_info_of_an_euler_clip_is_the_tools(walk_euler_clip, walk_euler_encoded, tmp_path):
+    path = tmp_path / "walk.kanim"
+    path.write_bytes(walk_euler_encoded[0])
+    import keyanim
+    info = keyanim.Clip(path).info
+    assert info == cli_json("info", path, "--json") and info["version"] == "3.0"
+
+
+def test_to_motion(keyanim, walk_clip, walk_euler_clip, walk_encoded, tmp_path):
     m = walk_clip.to_motion()
     assert m.frame_count == 344 and m.source is None
-    assert np.array_equal(m.channels, walk_clip.sample_frames(np.arange(344.0)).astype(np.float64))
+    assert_decoded_is_sampled(walk_clip, m.channels, walk_clip.sample_frames(np.arange(344.0)))
+    # Without quaternion nodes, the decoded values are the sampled ones, every channel.
+    e = walk_euler_clip.to_motion()
+    assert np.array_equal(e.channels, walk_euler_clip.sample_frames(np.arange(344.0)).astype(np.float64))
     m30 = walk_clip.to_motion(fps=30)
     assert m30.frame_count == int(np.floor(343 * 0.0083333 * 30 + 1e-6)) + 1
     assert m30.frame_time == pytest.approx(1 / 30)
@@ -178,7 +241,7 @@ def test_to_motion(keyanim, walk_clip, walk_encoded, tmp_path):
         assert info.value.kind == "invalid_argument"
 
 
-def test_a_rate_within_rounding_of_the_clips_own(keyanim, walk_clip):
+def test_a_rate_within_rounding_of_the_clips_own(keyanim, walk_clip, walk_euler_clip):
     # The walk stores Frame Time .0083333, a hair under 1/120 s: 120 fps is its own rate.
     source = walk_clip.to_motion()
     m120 = walk_clip.to_motion(fps=120)
@@ -187,7 +250,9 @@ def test_a_rate_within_rounding_of_the_clips_own(keyanim, walk_clip):
     # 240 fps: the source frames and one in-between each, at exact half frames.
     m240 = walk_clip.to_motion(fps=240)
     assert m240.frame_count == 687 == walk_clip.frame_count_at(240)
-    assert np.array_equal(m240.channels, walk_clip.sample_frames(np.arange(687) / 2).astype(np.float64))
+    assert_decoded_is_sampled(walk_clip, m240.channels, walk_clip.sample_frames(np.arange(687) / 2))
+    e240 = walk_euler_clip.to_motion(fps=240)
+    assert np.array_equal(e240.channels, walk_euler_clip.sample_frames(np.arange(687) / 2).astype(np.float64))
     # 40 fps: every third source frame; 119 fps: frames every 1/119 s up to the end.
     assert np.array_equal(walk_clip.frame_positions_at(40, [0, 1, 114]), [0.0, 3.0, 342.0])
     assert walk_clip.frame_count_at(40) == 115
@@ -213,14 +278,15 @@ def test_from_motion_keeps_every_frame(keyanim, walk, tmp_path):
     c = walk.channel_names.index("LeftUpLeg:Xrotation")
     f, v = clip.channel_keys(c)
     assert np.array_equal(f, np.arange(344))
-    assert clip.channel(c) == {"interpolation": "cardinal", "tension": 0.0, "key_count": 344}
+    assert clip.channel(c) == {"interpolation": "cardinal", "tension": 0.0, "key_count": 344, "stored": "value"}
+    assert clip.quat_nodes == [] and np.array_equal(clip.sample_stored([10.5]), clip.sample_frames([10.5]))
     assert clip.sample_frames(10.5)[c] == appendix_a(f, v, "cardinal", 0.0, "step_adjusted", 10.5)
 
 
 def test_positions_outside_the_clip_are_refused(keyanim, walk_clip):
     # As `keyanim sample --frame 1000` (exit 1): not clamped to the last frame (issue 28, item 18).
     calls = (lambda f: walk_clip.world_positions(frames=f), lambda f: walk_clip.sample_frames(f),
-             lambda f: walk_clip.local_transforms(frames=f))
+             lambda f: walk_clip.local_transforms(frames=f), lambda f: walk_clip.sample_stored(f))
     for call in calls:
         for bad in ([1000], [0, 344], [-1], [-0.5], [343.0001]):
             with pytest.raises(keyanim.Error) as info:
@@ -269,6 +335,10 @@ def test_info_parses_the_notes(keyanim, walk_clip, walk_encoded):
 def test_argument_errors(keyanim, walk_clip):
     with pytest.raises(ValueError, match="NaN"):
         walk_clip.sample([0.0, float("nan")])
+    with pytest.raises(ValueError, match="NaN"):
+        walk_clip.sample_stored([0.0, float("nan")])
+    with pytest.raises(TypeError):
+        walk_clip.sample_stored("soon")
     with pytest.raises(TypeError):
         walk_clip.sample("soon")
     with pytest.raises(TypeError):
@@ -337,12 +407,15 @@ def test_corpus_clips(keyanim, path, tmp_path):
     clip = keyanim.Clip(data)
     n = clip.frame_count
     positions = np.linspace(0, max(n - 1, 0), 41)
-    rows = clip.sample_frames(positions)
+    rows, stored = clip.sample_frames(positions), clip.sample_stored(positions)
     for c in range(0, clip.channel_count, 7):
         info = clip.channel(c)
         f, v = clip.channel_keys(c)
         want = [appendix_a(f, v, info["interpolation"], info["tension"], clip.info["tangent_rule"], x) for x in positions]
-        assert np.array_equal(rows[:, c], np.array(want, dtype=F))
+        assert np.array_equal(stored[:, c], np.array(want, dtype=F))
+        if info["stored"] == "value":
+            assert np.array_equal(rows[:, c], stored[:, c])
+    check_quat_nodes(clip, positions)
     bvh = parse_bvh(path)
     want = world_positions(bvh, rows.astype(np.float64))
     size = max(report["tolerance"] / 0.005, 1.0)
@@ -356,7 +429,7 @@ def test_corpus_clips(keyanim, path, tmp_path):
         np.testing.assert_allclose(clip.sample(times), rows, rtol=1e-5, atol=1e-5)
         m30 = clip.to_motion(fps=30)
         assert m30.frame_count == frames_at_rate(n, clip.frame_time, 30)
-    assert np.array_equal(clip.to_motion().channels, clip.sample_frames(np.arange(float(n))).astype(np.float64))
+    assert_decoded_is_sampled(clip, clip.to_motion().channels, clip.sample_frames(np.arange(float(n))))
     path = tmp_path / "clip.kanim"
     path.write_bytes(data)
     assert keyanim.Clip(path).info == cli_json("info", path, "--json")

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from conftest import HOP, WALK, corpus_files, frames_at_rate
+from conftest import HOP, WALK, assert_decoded_is_sampled, corpus_files, frames_at_rate
 
 
 @pytest.fixture(scope="module")
@@ -58,9 +58,27 @@ def test_windows_at_another_rate(keyanim, library):
     n_walk = math.floor(343 * walk.frame_time * 30 + 1e-6) + 1
     n_hop = math.floor(1101 * hop.frame_time * 30 + 1e-6) + 1
     assert len(ds) == expected_windows(n_walk, 16, 8) + expected_windows(n_hop, 16, 8)
-    # The windows are rows of Clip.to_motion(fps): the same positions, the same values.
+    # The windows are rows of Clip.to_motion(fps): the same positions, the same values (a
+    # quaternion node's rotation channels: Euler angles of the same rotations, see
+    # assert_decoded_is_sampled), and sample_frames at those positions bit for bit.
     rows = walk.to_motion(fps=30).channels
+    assert walk.quat_nodes
     for i in range(expected_windows(n_walk, 16, 8)):
+        _, first = ds.locate(i)
+        at = walk.frame_positions_at(30, np.arange(first, first + 16))
+        assert np.array_equal(ds.positions(i), at)
+        assert np.array_equal(ds[i], walk.sample_frames(at))
+        assert_decoded_is_sampled(walk, rows[first:first + 16], ds[i])
+
+
+def test_windows_of_euler_clips_at_another_rate(keyanim, tmp_path):
+    """Clips encoded with rotations='euler': the windows are rows of to_motion(fps), every value."""
+    (tmp_path / "walk.kanim").write_bytes(keyanim.encode(keyanim.read_bvh(WALK), rotations="euler")[0])
+    ds = keyanim.Dataset(tmp_path, fps=30, window=16, stride=8)
+    walk, = ds.clips
+    assert walk.quat_nodes == []
+    rows = walk.to_motion(fps=30).channels
+    for i in range(len(ds)):
         _, first = ds.locate(i)
         assert np.array_equal(ds[i].astype(np.float64), rows[first:first + 16])
 

@@ -92,6 +92,7 @@ def test_clip_sampling(long_clip):
     times = np.linspace(0, long_clip.duration, 200000)
     assert runs_beside(lambda: long_clip.sample(times))
     assert runs_beside(lambda: long_clip.sample_frames(times / long_clip.frame_time))
+    assert runs_beside(lambda: long_clip.sample_stored(times / long_clip.frame_time))
     assert runs_beside(lambda: long_clip.local_transforms(times[:60000]))
     assert runs_beside(lambda: long_clip.world_positions(times[:60000]))
     assert runs_beside(lambda: long_clip.to_motion(fps=1200))

@@ -50,6 +50,9 @@ exit_codes)
   grep -q 'bad.bvh:5:1: expected a number' "$T/.stderr" || die "malformed BVH error does not name the end of the file: $(cat "$T/.stderr")"
   [ ! -e x.kanim ] || die "a failed encode left an output"
   "$K" encode "$WALK" -o ok.kanim >/dev/null 2>&1
+  # -V names the format a default encode writes (the newest): 5.0, with quaternion nodes.
+  ver=$("$K" info ok.kanim --json | json 'd["version"]')
+  [ "$ver" = "5.0" ] && "$K" -V | grep -qF "(format $ver)" || die "-V says $("$K" -V), a default encode writes $ver"
   head -c 100 ok.kanim >cut.kanim
   expect_rc 2 "$K" decode cut.kanim -o cut.bvh
   [ ! -e cut.bvh ] || die "a failed decode left an output"

@@ -146,7 +146,7 @@ int run(int argc, char** argv) {
   }
   if (version) {
     if (g.verbosity == 0) std::cout << KEYANIM_VERSION_STRING "\n";
-    else std::cout << "keyanim " KEYANIM_VERSION_STRING " (format " << kFormatVersionMajor << "." << kFormatVersionMinor << ")\n";
+    else std::cout << "keyanim " KEYANIM_VERSION_STRING " (format " << kQuatFormatVersionMajor << "." << kQuatFormatVersionMinor << ")\n";
     return kOk;
   }
   if (rest.empty()) {
