@@ -13,6 +13,7 @@ export function clipFacts(clip, original) {
     ['duration', clip.frameTime > 0 ? `${fmt(Math.max(0, clip.frameCount - 1) * clip.frameTime, 4)} s` : '-'],
     ['joints', `${joints} (+${clip.nodes.length - joints} End Sites)`],
     ['channels', `${clip.channelCount}`],
+    ...(clip.version.major >= 5 ? [['quaternion nodes', `${clip.quatNodes.length} (rotations stored as quaternion curves)`]] : []),
     ['keys', `${clip.keyCount} (${fmt((100 * clip.keyCount) / Math.max(1, rawF32 / 4), 3)}% of all values)`],
     ['tangent rule', clip.tangentRule === 1 ? 'step_adjusted' : 'uniform'],
     ['bytes', bytes(clip.fileBytes)],

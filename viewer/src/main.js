@@ -15,7 +15,9 @@ app.loadEmbedded();
 // frame position x, in node order (the order of `keyanim sample --world --json`); frameCount and
 // nodeNames are the clip's, or the BVH's when it is shown alone; inView(x) shows frame position
 // x and gives, per node of the figure shown, its normalized device coordinates through the
-// page's camera and whether it is a placeholder (framing.js).
+// page's camera and whether it is a placeholder (framing.js); curveAt(c, x) is channel c at frame
+// position x as the curve panel draws it (a quaternion node's rotation channel: its Euler angle,
+// spec Appendix B).
 window.keyanim = {
   load(buffer, name = 'clip.kanim') { app.loadClip(new Uint8Array(buffer), name); },
   loadBank(buffer, name = 'clips.kbank') { app.loadBank(new Uint8Array(buffer), name); },
@@ -31,6 +33,10 @@ window.keyanim = {
     return Array.from({ length: app.clip.nodes.length }, (_, i) => [p[3 * i], p[3 * i + 1], p[3 * i + 2]]);
   },
   show(x) { app.show(x); },
+  curveAt(c, x) {
+    if (!app.clip) throw new Error('no clip loaded');
+    return app.curves.valueAt(c, x);
+  },
   inView(x) {
     app.show(x);
     return app.view.project(app.mainAt(x)).map((ndc, i) => ({ ndc, placeholder: app.extent.placeholders[i] === 1 }));

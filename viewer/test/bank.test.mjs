@@ -1,10 +1,12 @@
 // Banks (spec section 10) in the JS decoder, against keyanim's C++ side: banks packed by the
 // CLI from data/*.bvh (and one clip again under a folder, so that two clips share a skeleton),
-// archive without and with a dictionary and runtime: the clips' names, frames, frame times,
-// skeletons and sizes equal `keyanim list --json`; every clip samples bit for bit as
-// `keyanim sample BANK:NAME --json`, and decodes to the same clip as its own file from
-// `keyanim unpack`. Then banks that each break one rule of 10.1 to 10.5, refused with the
-// status and offset that `keyanim list` (the bank) or `keyanim verify BANK:NAME` (a clip) give.
+// archive without and with a dictionary and runtime (version 5.0: clips with quaternion nodes),
+// and archive with --rotations euler (version 4.1): the clips' names, frames, frame times,
+// skeletons and sizes equal `keyanim list --json`; every clip samples as `keyanim sample
+// BANK:NAME --json` (bit for bit, but a quaternion node's Euler angles within a binary32 ulp:
+// channels.mjs), and decodes to the same clip as its own file from `keyanim unpack`. Then banks
+// that each break one rule of 10.1 to 10.5, refused with the status and offset that `keyanim
+// list` (the bank) or `keyanim verify BANK:NAME` (a clip) give.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -13,14 +15,16 @@ import path from 'node:path';
 import { execFileSync, spawnSync } from 'node:child_process';
 import { decodeKanim, nodeLabel, CHANNEL_TYPES } from 'keyanim-three/decoder/kanim.js';
 import { openBank, decodeBankClip, findBankClip, looksLikeBank } from 'keyanim-three/decoder/bank.js';
-import { samplePose } from 'keyanim-three/decoder/sample.js';
+import { sampleChannels } from 'keyanim-three/decoder/sample.js';
+import { expectChannels } from './channels.mjs';
 import { xxh64 } from 'keyanim-three/decoder/xxh64.js';
 import { crc32 } from 'keyanim-three/decoder/crc32.js';
 import { keyanimCli, sourceDir, exists } from './paths.mjs';
 
 const skip = exists(keyanimCli) ? false : `no keyanim CLI at ${keyanimCli}`;
 const cli = (...args) => execFileSync(keyanimCli, args, { maxBuffer: 1 << 28, encoding: 'utf8' });
-const KINDS = { archive: ['--dictionary', 'off'], dictionary: ['--dictionary', 'on'], runtime: ['--runtime'] };
+const KINDS = { archive: ['--dictionary', 'off'], dictionary: ['--dictionary', 'on'], runtime: ['--runtime'], euler: ['--dictionary', 'off', '--rotations', 'euler'] };
+const VERSION = { archive: '5.0', dictionary: '5.0', runtime: '5.0', euler: '4.1' };
 
 let dir;
 const banks = {};  // kind -> { file, bytes }
@@ -49,6 +53,7 @@ function cliChannels(clip, json) {
 const essence = (c) => ({
   frames: c.frameCount, frameTime: c.frameTime, rule: c.tangentRule, notes: c.notes,
   nodes: c.nodes.map((n) => [n.name, n.parent, n.offset, n.endSite, n.channels]),
+  quatNodes: c.quatNodes.map((q) => [q.node, q.reference]),
   channels: c.channels.map((ch) => [ch.interp, ch.tension, Array.from(ch.keyFrames), Array.from(ch.values)]),
 });
 
@@ -57,6 +62,7 @@ for (const kind of Object.keys(KINDS)) {
     const { file, bytes } = banks[kind];
     const bank = openBank(bytes), want = JSON.parse(cli('list', file, '--json'));
     assert.ok(looksLikeBank(bytes));
+    assert.equal(`${bank.version.major}.${bank.version.minor}`, VERSION[kind]);
     assert.equal(bank.profile, want.profile);
     assert.equal(bank.skeletonCount, want.skeletons);
     assert.equal(bank.dictionaryBytes, want.dictionary_bytes);
@@ -82,12 +88,12 @@ for (const kind of Object.keys(KINDS)) {
       const clip = decodeBankClip(bank, c.index);
       assert.equal(clip.profile, bank.profile);
       assert.deepEqual(clip.bank, { name: c.name, index: c.index });
+      assert.equal(clip.version.major, kind === 'euler' ? 4 : 5, 'the CLI stores rotations as quaternions unless told otherwise');
+      assert.equal(clip.quatNodes.length > 0, kind !== 'euler');
       const F = clip.frameCount;
       for (const x of [0, 0.37, F / 3 + 0.123, F - 1.5, F - 1]) {
         const want = cliChannels(clip, JSON.parse(cli('sample', `${file}:${c.name}`, '--frame', String(x), '--json')));
-        const got = Array.from(samplePose(clip, x));
-        assert.equal(got.length, want.length);
-        for (let k = 0; k < got.length; ++k) if (!Object.is(got[k], want[k])) assert.fail(`${c.name} frame ${x}, channel ${k}: JS ${got[k]} != C++ ${want[k]}`);
+        expectChannels(clip, sampleChannels(clip, x), want, `${c.name} frame ${x}`, 'binary32');
       }
       const own = decodeKanim(fs.readFileSync(path.join(out, `${c.name}.kanim`)));
       assert.deepEqual(essence(clip), essence(own), c.name);
@@ -95,12 +101,22 @@ for (const kind of Object.keys(KINDS)) {
   });
 }
 
+// Spec 9: both profiles hold the same clip (the quaternion nodes and their references too).
+test('the runtime bank\'s clips are the archive bank\'s', { skip }, () => {
+  const archive = openBank(banks.archive.bytes), runtime = openBank(banks.runtime.bytes);
+  for (const c of archive.clips) {
+    const a = decodeBankClip(archive, c.index), r = decodeBankClip(runtime, findBankClip(runtime, c.name));
+    assert.ok(a.quatNodes.length > 0, c.name);
+    assert.deepEqual(essence(r), essence(a), c.name);
+  }
+});
+
 test('a dictionary bank\'s members have sections compressed with the dictionary', { skip }, () => {
   // Otherwise the test above would not reach the dictionary decoder (zstd-blocks.js).
   const bank = openBank(banks.dictionary.bytes);
   const clip = decodeBankClip(bank, 0);
   assert.ok(clip.sections.some((s) => s.compressed), clip.sections.map((s) => s.tag).join());
-  assert.deepEqual(clip.sections.map((s) => s.tag).slice(0, 4), ['CLIP', 'CHAN', 'KTIM', 'KVAL'], 'a member holds no SKEL');
+  assert.deepEqual(clip.sections.map((s) => s.tag).slice(0, 5), ['CLIP', 'QUAT', 'CHAN', 'KTIM', 'KVAL'], 'a member holds no SKEL');
 });
 
 test('a bank is not a clip, a clip not a bank, and a member alone is refused', { skip }, () => {
@@ -136,7 +152,8 @@ function fixMember(b, i, runtime) {
 const patched = (kind, fn) => Object.assign(() => { const b = banks[kind].bytes.slice(); fn(b, dv(b), layoutOf(b)); return b; }, { kind });
 
 // Each case: the bytes; `clip` (a name) when the bank opens and that clip is refused, the
-// others decoding; what the JS decoder must say: status, where, offset.
+// others decoding (or, with everyClip, refused as well); what the JS decoder must say: status,
+// where, offset.
 const cases = {
   'cut inside the header': { make: () => banks.archive.bytes.slice(0, 30), status: 'truncated', where: 'bank header', offset: 30 },
   'cut inside the index': { make: () => banks.archive.bytes.slice(0, 200), status: 'truncated', where: 'bank header', offset: 200 },
@@ -147,7 +164,8 @@ const cases = {
   '2^32 - 1 clips declared': { make: patched('archive', (b, v) => v.setUint32(16, 0xffffffff, true)), status: 'truncated', where: 'bank header', offset: (L, b) => b.length },
   '2^32 - 1 skeletons declared': { make: patched('archive', (b, v) => v.setUint32(20, 0xffffffff, true)), status: 'truncated', where: 'bank header', offset: (L, b) => b.length },
   'Names_Size 2^64 - 1': { make: patched('archive', (b, v) => v.setBigUint64(24, 2n ** 64n - 1n, true)), status: 'truncated', where: 'bank header', offset: (L, b) => b.length },
-  'major version 5': { make: patched('archive', (b) => { b[8] = 5; }), status: 'unsupported_version', where: 'bank header', offset: 8 },
+  'major version 6': { make: patched('archive', (b) => { b[8] = 6; }), status: 'unsupported_version', where: 'bank header', offset: 8 },
+  'major version 3': { make: patched('euler', (b) => { b[8] = 3; }), status: 'unsupported_version', where: 'bank header', offset: 8 },
   'a reserved Header_Flags bit': { make: patched('archive', (b) => { b[12] |= 8; }), status: 'reserved_bits_set', where: 'bank header', offset: 12 },
   'the Member bit in a bank header': { make: patched('archive', (b) => { b[12] |= 2; }), status: 'corrupt', where: 'bank header', offset: 12 },
   'a clip Offset one off': { make: patched('archive', (b, v, L) => { v.setBigUint64(L.clip(1).entry, BigInt(L.clip(1).offset + 8), true); fixBank(b); }), status: 'corrupt', where: 'clip table', offset: (L) => L.clip(1).entry },
@@ -170,6 +188,8 @@ const cases = {
   'an archive member in a runtime bank': { make: patched('runtime', (b, v, L) => { b[L.clip(0).offset + 12] &= ~1; fixMember(b, 0, true); }), clip: 0, status: 'corrupt', where: 'header', offset: (L) => L.clip(0).offset + 12 },
   'Frame_Count of the clip table one more': { make: patched('archive', (b, v, L) => { const e = L.clip(1).entry + 24; v.setUint32(e, v.getUint32(e, true) + 1, true); fixBank(b); }), clip: 1, status: 'corrupt', where: 'clip table', offset: (L) => L.clip(1).entry + 24 },
   'Frame_Time of the clip table doubled': { make: patched('runtime', (b, v, L) => { const e = L.clip(0).entry + 16; v.setFloat64(e, 2 * v.getFloat64(e, true), true); fixBank(b); }), clip: 0, status: 'corrupt', where: 'clip table', offset: (L) => L.clip(0).entry + 16 },
+  // 10.5: a member's major version is at most its bank's (the version 5.0 bank made 4.1).
+  'a member of version 5 in a bank of version 4': { make: patched('archive', (b) => { b[8] = 4; b[10] = 1; fixBank(b); }), clip: 0, status: 'corrupt', where: 'header', offset: (L) => L.clip(0).offset + 8, everyClip: true },
   'a non-zero padding byte before a member': { make: patched('archive', (b, v, L) => { const prev = L.clip(0), gap = L.clip(1).offset - (prev.offset + prev.size); assert.ok(gap > 0, 'the members leave padding'); b[prev.offset + prev.size] = 1; }), clip: 1, status: 'corrupt', where: 'padding', offset: (L) => L.clip(0).offset + L.clip(0).size },
 };
 
@@ -191,9 +211,24 @@ for (const [name, c] of Object.entries(cases)) {
     if (c.clip === undefined) { assert.throws(() => openBank(b), expect); return; }
     const bank = openBank(b), label = bank.clips[c.clip].name;
     assert.throws(() => decodeBankClip(bank, c.clip), (e) => expect(e) && e.where.startsWith(`clip ${JSON.stringify(label)} (#${c.clip})`));
+    if (c.everyClip) return;  // the others are refused too
     for (const other of bank.clips.filter((o) => o.index !== c.clip)) assert.equal(decodeBankClip(bank, other.index).frameCount, other.frameCount, `${other.name} still decodes`);
   });
 }
+
+// 10.5 the other way: members of version 4 in a bank of version 5.0 (the 4.1 bank relabelled) decode.
+test('a bank of version 5.0 whose members are of version 4 opens, and its clips decode', { skip }, () => {
+  const b = banks.euler.bytes.slice();
+  b[8] = 5; b[10] = 0;
+  fixBank(b);
+  const bank = openBank(b), file = path.join(dir, 'relabelled.kbank');
+  assert.deepEqual(bank.version, { major: 5, minor: 0 });
+  fs.writeFileSync(file, b);
+  for (const c of bank.clips) {
+    assert.equal(decodeBankClip(bank, c.index).version.major, 4);
+    assert.equal(spawnSync(keyanimCli, ['verify', `${file}:${c.name}`], { encoding: 'utf8' }).status, 0, `keyanim verify ${c.name}`);
+  }
+});
 
 // The C++ side on the same bytes: `keyanim list` opens the bank, `keyanim verify BANK:NAME`
 // reads a clip; both print "offset N (0x...): status:".

@@ -3,7 +3,8 @@
 // after mixer.setTime and updateMatrixWorld) at whole and fractional frames equals `keyanim
 // sample --frame F --world --json` within the clip's tolerance (`keyanim info --json`:
 // guarantee.tolerance_units), and so at every quarter frame of the first 40 (channels from
-// `keyanim decode --inbetweens 3`, forward kinematics by pose.js), with keys at the source
+// `keyanim decode --inbetweens 3`: a BVH of Euler angles, read with its own nodes; forward
+// kinematics by pose.js), with keys at the source
 // frames and at a caller's rate; the bones have the BVH's names and hierarchy (the viewer's BVH
 // reader on the original), End Sites as leaf bones.
 import assert from 'node:assert/strict';
@@ -110,7 +111,9 @@ export function checkClip(bvh) {
     const quarter = parseBvh(cli('decode', file, '-o', '-', '--inbetweens', '3', '--frames', `0:${last}`));
     for (let r = 0; r < quarter.frameCount; ++r) {
       play.at(r / 4);
-      const want = worldPositions(result.kanim.nodes, quarter.frames.subarray(r * quarter.channelCount, (r + 1) * quarter.channelCount));
+      // The decoded BVH's channels are Euler angles (spec Appendix B), also a quaternion node's:
+      // read with the BVH's nodes, not the clip's (whose values are stored x, y, z).
+      const want = worldPositions(quarter.nodes, quarter.frames.subarray(r * quarter.channelCount, (r + 1) * quarter.channelCount));
       const v = new THREE.Vector3();
       result.skeleton.bones.forEach((b, i) => {
         const d = b.getWorldPosition(v).distanceTo(new THREE.Vector3().fromArray(want, 3 * i));

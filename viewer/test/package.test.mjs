@@ -1,8 +1,8 @@
 // keyanim-three as a user installs it: `npm pack` (offline) gives a tarball with the package's
 // sources and README and nothing else; `npm install` of it in a fresh folder, with three,
 // gives a package (a copy, not a link to this tree) whose `import { KanimLoader } from
-// 'keyanim-three'` works under node: a spec test vector parses to the skeleton and clip the
-// workspace's decoder reads from it.
+// 'keyanim-three'` works under node: spec test vectors (3.0 with zstd sections, 5.0 with
+// quaternion nodes) parse to the skeleton and clip the workspace's decoder reads from them.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -13,7 +13,7 @@ import { decodeKanim, nodeLabel } from 'keyanim-three/decoder/kanim.js';
 import { pack, installFresh, packageDir } from './packed.mjs';
 import { vectorsDir } from './paths.mjs';
 
-const VECTOR = path.join(vectorsDir, 'v3_long.kanim');  // zstd sections: fzstd is installed and works
+const VECTORS = [path.join(vectorsDir, 'v3_long.kanim'), path.join(vectorsDir, 'v5_quat.kanim')];  // zstd sections: fzstd is installed and works
 let dir, packed, app;
 before(() => {
   dir = fs.mkdtempSync(path.join(os.tmpdir(), 'keyanim-three-pack-'));
@@ -42,16 +42,19 @@ const mixer = new THREE.AnimationMixer(root);
 mixer.clipAction(clip).play();
 mixer.setTime(clip.duration / 2);
 console.log(JSON.stringify({ bones: skeleton.bones.map((b) => b.name), isBone: root.isBone === true,
-  duration: clip.duration, tracks: clip.tracks.length, frames: kanim.frameCount }));
+  duration: clip.duration, tracks: clip.tracks.length, frames: kanim.frameCount, quatNodes: kanim.quatNodes.length }));
 `);
-  const out = JSON.parse(execFileSync(process.execPath, [script, VECTOR], { cwd: app, encoding: 'utf8' }));
-  const clip = decodeKanim(fs.readFileSync(VECTOR));
-  assert.deepEqual(out.bones, clip.nodes.map((_, i) => nodeLabel(clip.nodes, i)));
-  assert.equal(out.frames, clip.frameCount);
-  assert.ok(Math.abs(out.duration - (clip.frameCount - 1) * clip.frameTime) < 1e-9);
-  const rotated = clip.nodes.filter((n) => n.channels.some((t) => t >= 3)).length;
-  const moved = clip.nodes.filter((n) => n.channels.some((t) => t < 3)).length;
-  assert.equal(out.tracks, rotated + moved);
+  for (const vector of VECTORS) {
+    const out = JSON.parse(execFileSync(process.execPath, [script, vector], { cwd: app, encoding: 'utf8' }));
+    const clip = decodeKanim(fs.readFileSync(vector));
+    assert.deepEqual(out.bones, clip.nodes.map((_, i) => nodeLabel(clip.nodes, i)));
+    assert.equal(out.frames, clip.frameCount);
+    assert.equal(out.quatNodes, clip.quatNodes.length);
+    assert.ok(Math.abs(out.duration - (clip.frameCount - 1) * clip.frameTime) < 1e-9);
+    const rotated = clip.nodes.filter((n) => n.channels.some((t) => t >= 3)).length;
+    const moved = clip.nodes.filter((n) => n.channels.some((t) => t < 3)).length;
+    assert.equal(out.tracks, rotated + moved);
+  }
   // What was installed is this tree's package, file for file.
   for (const f of packed.files) assert.ok(fs.readFileSync(path.join(installed, f)).equals(fs.readFileSync(path.join(packageDir, f))), f);
 });

@@ -1,5 +1,5 @@
-// Banks (spec/FORMAT.md section 10, version 4.1): many clips in one file, each distinct skeleton
-// once. openBank checks the index (10.1 to 10.4, in the order keyanim does: header, where every
+// Banks (spec/FORMAT.md section 10, versions 4.1 and 5.0): many clips in one file, each distinct
+// skeleton once; a bank of version 5 may hold clips of version 5 (quaternion nodes). openBank checks the index (10.1 to 10.4, in the order keyanim does: header, where every
 // part lies, the bank's checksum, then names, name order and dictionary) without reading any
 // member; decodeBankClip decodes one member (10.5) into the clip decodeKanim makes of a file, so
 // that a damaged clip is refused by name while the others still decode.
@@ -40,7 +40,7 @@ export function openBank(input, limits = DEFAULT_LIMITS) {
     version: { major: h.major, minor: h.minor }, profile: h.runtime ? 'runtime' : 'archive', byteLength: bytes.length,
     skeletonCount: h.skeletons, dictionaryBytes: Number(h.dictionarySize), order: names.order,
     clips: clips.map((c, i) => ({ ...c, name: names.text[i], duration: c.frameCount > 1 ? (c.frameCount - 1) * c.frameTime : 0 })),
-    [BANK]: { bytes, view, runtime: h.runtime, dictionary, skeletons: skeletons.entries, contents, names: names.bytes },
+    [BANK]: { bytes, view, major: h.major, runtime: h.runtime, dictionary, skeletons: skeletons.entries, contents, names: names.bytes },
   };
 }
 
@@ -56,7 +56,7 @@ function readHeader(bytes, view) {
   if (bytes.length < HEADER) fail('truncated', 'bank header', bytes.length, 'the file ends inside the bank header');
   const major = view.getUint16(8, true), minor = view.getUint16(10, true), flags = view.getUint32(12, true);
   if (!(flags & 4)) fail('invalid_argument', 'bank header', 12, 'a file of one clip, not a bank (Header_Flags bit 2 is clear): open it as a clip');
-  if (major !== 4) fail('unsupported_version', 'bank header', 8, `major version ${major} (banks are version 4, section 10)`);
+  if (major !== 4 && major !== 5) fail('unsupported_version', 'bank header', 8, `major version ${major} (banks are versions 4 and 5, section 10)`);
   if (flags & 0xfff8) fail('reserved_bits_set', 'bank header', 12, 'reserved Header_Flags bits are set');
   if (flags & 2) fail('corrupt', 'bank header', 12, "a bank's header has Header_Flags bit 1 (Member) set");
   const runtime = (flags & 1) !== 0;
@@ -253,7 +253,7 @@ export function decodeBankClip(bank, i, limits = DEFAULT_LIMITS) {
     const end = i === 0 ? c.offset : bank.clips[i - 1].offset + bank.clips[i - 1].size;
     if (!isZero(b.bytes, end, c.offset)) fail('corrupt', 'padding', end, `clip table entry ${i}: the padding before it is not zero`);
     const k = b.skeletons[c.skeleton];
-    const member = { runtime: b.runtime, skel: b.contents[c.skeleton], skelOffset: k.offset - c.offset, skelCompressed: k.compressed, dictionary: b.dictionary };
+    const member = { major: b.major, runtime: b.runtime, skel: b.contents[c.skeleton], skelOffset: k.offset - c.offset, skelCompressed: k.compressed, dictionary: b.dictionary };
     const clip = inMember(c.offset, () => decodeClip(b.bytes.subarray(c.offset, c.offset + c.size), limits, member));
     if (clip.frameCount !== c.frameCount) fail('corrupt', 'clip table', c.entry + 24, `Frame_Count ${c.frameCount}, the clip's CLIP says ${clip.frameCount}`);
     if (!sameBits(clip.frameTime, c.frameTime)) fail('corrupt', 'clip table', c.entry + 16, `Frame_Time ${c.frameTime}, the clip's CLIP says ${clip.frameTime}`);

@@ -1,9 +1,10 @@
 // The .kanim decoder, written from spec/FORMAT.md alone: container (sections 1-3), the CLIP,
-// SKEL, CHAN, KTIM and NOTE sections (4), the checks of sections 5-8, in the order section 7
-// recommends. Archive files of versions 3.0 and 4.0 and, by Appendix E, 1.0 and 2.0; runtime
-// files of 4.0 (section 9: table rules in table-rules.js, IMAG in imag.js); a bank's members
-// (section 10.5: decodeClip with the bank's skeleton and dictionary; banks: bank.js). Key
-// values: kval.js; sampling (Appendix A): sample.js.
+// SKEL, QUAT, CHAN, KTIM and NOTE sections (4), the checks of sections 5-8, in the order
+// section 7 recommends. Archive files of versions 3.0, 4.0 and 5.0 (quaternion nodes, 4.7:
+// quat-nodes.js) and, by Appendix E, 1.0 and 2.0; runtime files of 4.0 and 5.0 (section 9:
+// table rules in table-rules.js, IMAG in imag.js); a bank's members (section 10.5: decodeClip
+// with the bank's skeleton and dictionary; banks: bank.js). Key values: kval.js; sampling
+// (Appendix A): sample.js; rotations (4.7, Appendix B): rotation.js.
 import { fail, KanimError } from './errors.js';
 import { SectionReader } from './reader.js';
 import { crc32 } from './crc32.js';
@@ -12,6 +13,7 @@ import { archiveRules, runtimeRules } from './table-rules.js';
 import { decodeImage } from './imag.js';
 import { decompressSection, isZstdFailure } from './zstd.js';
 import { decodeKeyValues } from './kval.js';
+import { parseQuat } from './quat-nodes.js';
 
 export { KanimError };
 
@@ -21,12 +23,14 @@ export const MAX_FRAMES_V3 = 2 ** 24;
 
 // Spec section 8, limits that follow from the file's size: no zstd frame makes more than 32768
 // bytes of each of its bytes (a 4-byte RLE block makes 128 KiB at most, the best any block
-// does), and a key takes a byte of KTIM at least. So a compressed section holds at most 32768
-// times its Stored_Size, and a file of N bytes at most 32768 N keys: counts beyond are refused
-// as they are read, before anything is inflated or allocated, with the status a later step
-// would give (zstd_error, corrupt).
+// does), and a key takes a byte of KTIM at least (a third of one in version 5, where a
+// quaternion node's three keys at a frame share a varint). So a compressed section holds at
+// most 32768 times its Stored_Size, and a file of N bytes at most 32768 N keys (98304 N in
+// version 5): counts beyond are refused as they are read, before anything is inflated or
+// allocated, with the status a later step would give (zstd_error, corrupt).
 export const MAX_ZSTD_EXPANSION = 32768;
 export const MAX_KEYS_PER_FILE_BYTE = MAX_ZSTD_EXPANSION;
+const maxKeysPerFileByte = (major) => (major >= 5 ? 3 : 1) * MAX_KEYS_PER_FILE_BYTE;
 
 // keyanim's defaults (spec section 8).
 export const DEFAULT_LIMITS = Object.freeze({
@@ -52,12 +56,13 @@ export function decodeKanim(input, limits = DEFAULT_LIMITS) {
 
 // A file by itself (member null) or a bank's member (spec 10.5; bank.js): member is { runtime,
 // skel: the bank's skeleton's content, skelOffset: where its stored bytes lie relative to the
-// member's first byte, skelCompressed, dictionary: readDictionary's, or null }.
+// member's first byte, skelCompressed, dictionary: readDictionary's, or null, major: the bank's
+// Major_Version }.
 export function decodeClip(bytes, limits, member) {
   const { version, profile, sections } = readContainer(bytes, limits, member);
   const clip = makeClip(version, profile, bytes.length, sections);
-  const parsers = PARSERS[profile];
-  for (const s of withMemberSkeleton(sections, profile, member)) {
+  const parsers = parsersOf(profile, version.major);
+  for (const s of parseOrder(withMemberSkeleton(sections, profile, member), profile)) {
     const parse = parsers[s.tag];
     if (!parse) continue;  // an ancillary section of a later minor version
     parse(new SectionReader(s.tag, s.content ?? sectionContent(bytes, s, member?.dictionary), s.offset, s.compressed), clip, limits);
@@ -75,13 +80,27 @@ function withMemberSkeleton(sections, profile, member) {
   return [...sections.slice(0, at), skel, ...sections.slice(at)];
 }
 
+// Sections are parsed in table order, but in the runtime profile SKEL before IMAG (section 7):
+// in version 5 IMAG's quaternion nodes are checked against the skeleton (9.4).
+function parseOrder(sections, profile) {
+  if (profile !== 'runtime') return sections;
+  const skel = sections.findIndex((s) => s.tag === 'SKEL'), imag = sections.findIndex((s) => s.tag === 'IMAG');
+  if (skel < 0 || imag < 0 || skel < imag) return sections;
+  const out = sections.slice();
+  [out[imag], out[skel]] = [out[skel], out[imag]];
+  return out;
+}
+
 // profile: 'archive' (sections 2-8) or 'runtime' (section 9); either gives the same clip.
+// quatNodes (version 5, 4.7): the quaternion nodes in node order, { node, column: the channel of
+// its stored x, reference: [X, Y, Z] (integers), r: the reference as a unit quaternion [x, y, z,
+// w] }; the same object is that node's `quaternion` (null for every other node).
 function makeClip(version, profile, fileBytes, sections) {
   return {
     version, profile, fileBytes,
     sections: sections.map(({ tag, compressed, storedSize, rawSize }) => ({ tag, compressed, storedSize, rawSize })),
     frameCount: 0, frameTime: 0, tangentRule: 0, nodeCount: 0, channelCount: 0, keyCount: 0,
-    nodes: [], channels: [], notes: '',
+    nodes: [], channels: [], quatNodes: [], notes: '',
   };
 }
 
@@ -95,18 +114,18 @@ function readContainer(bytes, limits, member) {
   if (bytes.length < 24) fail('truncated', 'header', bytes.length, 'the file ends inside the header');
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const major = view.getUint16(8, true), minor = view.getUint16(10, true);
-  if (major < 1 || major > 4) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 4)`);
+  if (major < 1 || major > 5) fail('unsupported_version', 'header', 8, `major version ${major} (this decoder reads versions 1 to 5)`);
   const flags = view.getUint32(12, true);
   checkHeaderFlags(major, flags, member);
-  const profile = major === 4 && (flags & 1) ? 'runtime' : 'archive';
+  const profile = major >= 4 && (flags & 1) ? 'runtime' : 'archive';
   const checksumBytes = profile === 'runtime' ? 8 : 4;  // XXH64 (9.1.3) or CRC-32 (3.3)
   const count = view.getUint32(16, true);
   if (view.getUint32(20, true) !== 0) fail('reserved_bits_set', 'header', 20, 'Header_Reserved is not 0');
   const tableEnd = 24 + 24 * count;
   if (bytes.length < tableEnd) fail('truncated', 'section table', bytes.length, `the file ends inside the table of ${count} sections`);
 
-  const parsers = PARSERS[profile];
-  const rules = profile === 'runtime' ? runtimeRules(!!member) : archiveRules(!!member);
+  const parsers = parsersOf(profile, major);
+  const rules = profile === 'runtime' ? runtimeRules(!!member, major) : archiveRules(!!member, major);
   const sections = readTable(bytes, view, count, rules, checksumBytes);
   checkLength(bytes.length, tableEnd, sections, checksumBytes);
   let raw = member ? BigInt(member.skel.length) : 0n;  // a member's skeleton counts as its SKEL (10.5.3)
@@ -124,15 +143,17 @@ function readContainer(bytes, limits, member) {
   return { version: { major, minor }, profile, sections };
 }
 
-// Bit 0 Runtime in version 4 (spec 2.2); bit 1 Member and bit 2 Bank from 4.1 on (10.2, 10.5):
-// a member only in its bank, a bank never as a clip; bits 3-15 reserved (0-15 before 4).
+// Bit 0 Runtime in versions 4 and 5 (spec 2.2); bit 1 Member and bit 2 Bank from 4.1 on (10.2,
+// 10.5): a member only in its bank, a bank never as a clip; bits 3-15 reserved (0-15 before 4).
+// A bank's member is of its bank's major version or a lower one (10.5).
 function checkHeaderFlags(major, flags, member) {
-  if (flags & (major === 4 ? 0xfff8 : 0xffff)) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
-  if (major !== 4) return;
+  if (flags & (major >= 4 ? 0xfff8 : 0xffff)) fail('reserved_bits_set', 'header', 12, 'reserved Header_Flags bits are set');
+  if (major < 4) return;
   if (!member && flags & 4) fail('invalid_argument', 'header', 12, 'a bank of many clips (spec section 10), not a clip: open it as a bank (openBank)');
   if (!member && flags & 2) fail('corrupt', 'header', 12, "a bank's member (Header_Flags bit 1), which only its bank reads");
   if (member && (!(flags & 2) || flags & 4)) fail('corrupt', 'header', 12, "a bank's clip must have Header_Flags bit 1 (Member) set and bit 2 (Bank) clear");
   if (member && (flags & 1) !== (member.runtime ? 1 : 0)) fail('corrupt', 'header', 12, "a bank's clips are of the bank's profile (Header_Flags bit 0)");
+  if (member && major > (member.major ?? 4)) fail('corrupt', 'header', 8, `a clip of version ${major} in a bank of version ${member.major ?? 4} (a member's major version is at most its bank's)`);
 }
 
 const hex = (v, digits) => v.toString(16).padStart(digits, '0');
@@ -198,7 +219,7 @@ function sectionContent(bytes, s, dictionary) {
 
 function parseClip(r, clip, limits) {
   if (r.length !== 32) r.fail('corrupt', 0, `CLIP holds ${r.length} bytes, not 32`);
-  const v3 = clip.version.major >= 3;  // 3.0 and 4.0 (both profiles)
+  const v3 = clip.version.major >= 3;  // 3.0, 4.0 and 5.0 (both profiles)
   const frames = r.u32();
   if (v3 && frames > MAX_FRAMES_V3) r.fail('corrupt', 0, `Frame_Count ${frames} is above 2^24`);
   if (frames > limits.frames) r.fail('limit_exceeded', 0, `Frame_Count ${frames} is above the limit of ${limits.frames}`);
@@ -215,7 +236,8 @@ function parseClip(r, clip, limits) {
   if (frames > 1 && !(frameTime > 0)) r.fail('corrupt', 16, `Frame_Time is 0 with ${frames} frames`);
   const keys = r.u64();
   if (keys > BigInt(limits.keys)) r.fail('limit_exceeded', 24, `Key_Count ${keys} is above the limit of ${limits.keys}`);
-  if (keys > BigInt(MAX_KEYS_PER_FILE_BYTE) * BigInt(clip.fileBytes)) r.fail('corrupt', 24, `Key_Count ${keys} is more than a file of ${clip.fileBytes} bytes can hold (at most ${MAX_KEYS_PER_FILE_BYTE} keys a byte: a key takes a byte of KTIM at least, and zstd makes at most ${MAX_ZSTD_EXPANSION} bytes of each)`);
+  const perByte = maxKeysPerFileByte(clip.version.major);
+  if (keys > BigInt(perByte) * BigInt(clip.fileBytes)) r.fail('corrupt', 24, `Key_Count ${keys} is more than a file of ${clip.fileBytes} bytes can hold (at most ${perByte} keys a byte: a key takes ${perByte > MAX_KEYS_PER_FILE_BYTE ? 'a third of ' : ''}a byte of KTIM at least, and zstd makes at most ${MAX_ZSTD_EXPANSION} bytes of each)`);
   if (keys > BigInt(channels) * BigInt(frames)) r.fail('corrupt', 24, `Key_Count ${keys} is above Channel_Count x Frame_Count`);
   Object.assign(clip, { frameCount: frames, nodeCount: nodes, channelCount: channels, tangentRule: rule, frameTime, keyCount: Number(keys) });
 }
@@ -254,7 +276,7 @@ function parseSkel(r, clip) {
       if (type > 5) r.fail('reserved_bits_set', at, `${what}: reserved channel type ${type}`);
       channels.push(type);
     }
-    clip.nodes.push({ name, parent, offset, endSite, channels, firstChannel: channelSum });
+    clip.nodes.push({ name, parent, offset, endSite, channels, firstChannel: channelSum, quaternion: null });
     channelSum += count;
   }
   r.expectEnd(`the ${n} node records`);
@@ -263,7 +285,7 @@ function parseSkel(r, clip) {
 
 function parseChan(r, clip) {
   const c = clip.channelCount, major = clip.version.major;
-  const perChannel = { 1: 17, 2: 18, 3: 19, 4: 19 }[major];
+  const perChannel = { 1: 17, 2: 18, 3: 19, 4: 19, 5: 19 }[major];
   if (r.length !== perChannel * c) r.fail('corrupt', 0, `CHAN holds ${r.length} bytes, not ${perChannel} x ${c}`);
   const channels = [];
   clip.nodes.forEach((node, n) => node.channels.forEach((type) => channels.push({ node: n, type })));
@@ -298,12 +320,39 @@ function parseChan(r, clip) {
     });
   }
   if (keys !== clip.keyCount) r.fail('corrupt', 13 * c, `the channels have ${keys} keys, CLIP says ${clip.keyCount}`);
+  checkQuatChannels(r, clip, channels);
   clip.channels = channels;
 }
 
+// Version 5 (4.3): a quaternion node's stored x, y, z have one Interpolation, one Tension (the
+// same bits) and one Key_Count; reported at the y's or z's entry that differs from the x's.
+function checkQuatChannels(r, clip, channels) {
+  const c = clip.channelCount, bits = new DataView(new ArrayBuffer(4));
+  const tensionBits = (t) => { bits.setFloat32(0, t, true); return bits.getUint32(0, true); };
+  const arrays = [
+    ['Interpolation', (ch) => ch.interp, (k) => k],
+    ['Tension', (ch) => tensionBits(ch.tension), (k) => c + 4 * k],
+    ['Key_Count', (ch) => ch.keyCount, (k) => 13 * c + 4 * k],
+  ];
+  for (const q of clip.quatNodes) {
+    for (const [name, get, at] of arrays) {
+      for (const k of [q.column + 1, q.column + 2]) {
+        if (get(channels[k]) !== get(channels[q.column])) r.fail('corrupt', at(k), `channel ${k}: its ${name} differs from channel ${q.column}'s, and both are stored x, y, z of quaternion node ${q.node} (4.3)`);
+      }
+    }
+  }
+}
+
+// Version 5 (4.4): a quaternion node's stored y and z have no varints; their key frames are its
+// stored x's (the same array). KF, the key frame count, is K without their keys.
 function parseKtim(r, clip) {
-  if (clip.keyCount > r.length) r.fail('corrupt', 0, `KTIM is too short for ${clip.keyCount} keys`);
+  const shared = new Map();  // channel -> the channel whose key frames it shares
+  for (const q of clip.quatNodes) { shared.set(q.column + 1, q.column); shared.set(q.column + 2, q.column); }
+  let frameCount = clip.keyCount;
+  for (const c of shared.keys()) frameCount -= clip.channels[c].keyCount;
+  if (frameCount > r.length) r.fail('corrupt', 0, `KTIM is too short for ${frameCount} key frames`);
   clip.channels.forEach((ch, c) => {
+    if (shared.has(c)) { ch.keyFrames = clip.channels[shared.get(c)].keyFrames; return; }
     const frames = new Int32Array(ch.keyCount);
     let prev = -1;
     for (let i = 0; i < ch.keyCount; ++i) {
@@ -314,7 +363,7 @@ function parseKtim(r, clip) {
     }
     ch.keyFrames = frames;
   });
-  r.expectEnd(`the ${clip.keyCount} key frames`);
+  r.expectEnd(`the ${frameCount} key frames`);
 }
 
 function parseNote(r, clip) {
@@ -326,8 +375,11 @@ function nameChannels(clip) {
   clip.nodes.forEach((node, n) => node.channels.forEach((type, k) => Object.assign(clip.channels[node.firstChannel + k], { node: n, type })));
 }
 
-// The sections each profile decodes (and counts for rule 3.2.6); any other is skipped.
+// The sections each profile decodes (and counts for rule 3.2.6); any other is skipped. QUAT is
+// a section of version 5 only: before, it is an unknown tag (3.2.3).
 const PARSERS = {
   archive: { CLIP: parseClip, SKEL: parseSkel, CHAN: parseChan, KTIM: parseKtim, KVAL: decodeKeyValues, NOTE: parseNote },
+  archive5: { CLIP: parseClip, SKEL: parseSkel, QUAT: parseQuat, CHAN: parseChan, KTIM: parseKtim, KVAL: decodeKeyValues, NOTE: parseNote },
   runtime: { CLIP: parseClip, IMAG: decodeImage, SKEL: parseSkel, NOTE: parseNote },
 };
+const parsersOf = (profile, major) => PARSERS[profile === 'archive' && major >= 5 ? 'archive5' : profile];

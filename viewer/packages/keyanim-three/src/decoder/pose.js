@@ -1,8 +1,12 @@
 // Forward kinematics as spec/FORMAT.md Appendix B: a node's local rotation is the product of
-// its rotation channels in channel order (intrinsic, degrees, right-handed); its translation is
-// its Offset with each position channel replacing its component (reading 'replace', Blender's
-// and the default) or added to it ('add', three.js's); p = p_parent + R_parent p_local,
-// R = R_parent R_local. In binary64. Works on the node lists of kanim.js and bvh.js alike.
+// its rotation channels in channel order (intrinsic, degrees, right-handed), or for a quaternion
+// node (version 5, 4.7: node.quaternion set by the decoder) the rotation its stored x, y, z make
+// with its reference; its translation is its Offset with each position channel replacing its
+// component (reading 'replace', Blender's and the default) or added to it ('add', three.js's);
+// p = p_parent + R_parent p_local, R = R_parent R_local. In binary64. Works on the node lists
+// of kanim.js and bvh.js alike: with a decoded clip's nodes, `values` are the channel values
+// samplePose gives (a quaternion node's stored x, y, z); with a BVH's, its channels.
+import { storedRotation, quaternionMatrix } from './rotation.js';
 
 const DEG = Math.PI / 180;
 
@@ -24,18 +28,21 @@ function axisRotation(axis, degrees, out) {
 // row-major). Returns out.
 export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.length), reading = 'replace',
                                rot = new Float64Array(9 * nodes.length)) {
-  const local = new Float64Array(9), axis = new Float64Array(9), tmp = new Float64Array(9);
+  const local = new Float64Array(9), axis = new Float64Array(9), tmp = new Float64Array(9), stored = [];
   for (let i = 0; i < nodes.length; ++i) {
     const node = nodes[i];
     const t = node.offset.slice();
     local.set([1, 0, 0, 0, 1, 0, 0, 0, 1]);
+    stored.length = 0;
     node.channels.forEach((type, k) => {
       const v = values[node.firstChannel + k];
       if (type < 3) { t[type] = reading === 'add' ? node.offset[type] + v : v; return; }
+      if (node.quaternion) { stored.push(v); return; }
       axisRotation(type - 3, v, axis);
       mul(local, axis, tmp);
       local.set(tmp);
     });
+    if (stored.length === 3) local.set(quaternionMatrix(storedRotation(node.quaternion.r, stored[0], stored[1], stored[2])));
     const R = rot.subarray(9 * i, 9 * i + 9);
     if (node.parent < 0) {
       R.set(local);
@@ -52,7 +59,7 @@ export function worldPositions(nodes, values, out = new Float64Array(3 * nodes.l
 // The largest side of the box around the rest pose (every channel 0 but positions keep the
 // Offset): the length scale of the skeleton, for tolerances, the camera and the grid.
 export function skeletonSize(nodes) {
-  const rest = nodes.map((n) => ({ ...n, channels: [] }));
+  const rest = nodes.map((n) => ({ ...n, channels: [], quaternion: null }));
   const p = worldPositions(rest, []);
   let size = 0;
   for (let axis = 0; axis < 3; ++axis) {

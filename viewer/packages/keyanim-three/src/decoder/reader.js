@@ -27,6 +27,7 @@ export class SectionReader {
   }
 
   u8(what) { this.need(1, what); return this.bytes[this.pos++]; }
+  i16(what) { this.need(2, what); const v = this.view.getInt16(this.pos, true); this.pos += 2; return v; }
   u16(what) { this.need(2, what); const v = this.view.getUint16(this.pos, true); this.pos += 2; return v; }
   u32(what) { this.need(4, what); const v = this.view.getUint32(this.pos, true); this.pos += 4; return v; }
   i32(what) { this.need(4, what); const v = this.view.getInt32(this.pos, true); this.pos += 4; return v; }

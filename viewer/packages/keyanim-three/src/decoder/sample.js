@@ -1,6 +1,10 @@
 // Appendix A: the value of a channel at a frame position, in binary32. Every operation is one
 // binary64 operation on binary32 operands rounded by Math.fround, which equals the binary32
 // operation (binary64 has more than 2 x 24 + 2 bits, so the double rounding is innocuous).
+// samplePose gives every channel's stored value (a quaternion node's stored x, y, z: 4.7);
+// sampleChannels the BVH channel values (Appendix B: its rotation as Euler angles instead).
+import { storedRotation, eulerFromQuaternion, rotationAxes } from './rotation.js';
+
 const f32 = Math.fround;
 
 // Largest j < n - 1 with keyFrames[j] <= f (the caller has f > k_0 and f < k_{n-1}).
@@ -48,6 +52,24 @@ export function samplePose(clip, x, out = new Float32Array(clip.channels.length)
   const f = f32(x);
   if (Number.isNaN(f)) throw new RangeError('the frame position is NaN');
   for (let c = 0; c < clip.channels.length; ++c) out[c] = channelValue(clip.channels[c], clip.tangentRule, f);
+  return out;
+}
+
+// The BVH channel values at frame position x (Appendix B), into `out` (binary64): every channel
+// as samplePose gives it, except a quaternion node's rotation channels (version 5), which hold
+// the Euler angles in degrees of its rotation (4.7) in its channel order. `previous`: the values
+// this gave for the position before in a sequence (or null): each quaternion node then gets,
+// of the two sets of angles of its rotation, the one nearest the previous (whole turns added),
+// so that the sequence is continuous; without it, the set with the middle angle in [-90, 90].
+export function sampleChannels(clip, x, out = new Float64Array(clip.channels.length), previous = null) {
+  const stored = samplePose(clip, x);
+  out.set(stored);
+  for (const q of clip.quatNodes) {
+    const c = q.column, node = clip.nodes[q.node];
+    const rotation = storedRotation(q.r, stored[c], stored[c + 1], stored[c + 2]);
+    const angles = eulerFromQuaternion(rotation, rotationAxes(node), previous ? [previous[c], previous[c + 1], previous[c + 2]] : null);
+    out.set(angles, c);
+  }
   return out;
 }
 

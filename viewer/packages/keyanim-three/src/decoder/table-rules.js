@@ -2,10 +2,12 @@
 // (runtime). Each returns { entry(e), end() }, called per table entry (e: index, tag,
 // compressed, ancillary, entry = the entry's file offset, where = its name for messages) and
 // once after the last; they throw KanimError. `member`: the table of a bank's member, which
-// holds no SKEL (spec 10.5.2: its skeleton is the bank's).
+// holds no SKEL (spec 10.5.2: its skeleton is the bank's). `major`: the file's Major_Version
+// (version 5 adds QUAT, between SKEL and CHAN in the archive profile; none in the runtime's).
 import { fail } from './errors.js';
 
 const ARCHIVE_CRITICAL = ['CLIP', 'SKEL', 'CHAN', 'KTIM', 'KVAL'];
+const ARCHIVE_CRITICAL_5 = ['CLIP', 'SKEL', 'QUAT', 'CHAN', 'KTIM', 'KVAL'];
 const RUNTIME_SECTIONS = ['CLIP', 'IMAG', 'SKEL'];
 const withoutSkel = (tags) => tags.filter((t) => t !== 'SKEL');
 
@@ -19,8 +21,9 @@ function checkNote(e, seen) {
   if (seen) fail('corrupt', 'section table', e.entry, `${e.where}: a second NOTE section`);
 }
 
-export function archiveRules(member = false) {
-  const CRITICAL = member ? withoutSkel(ARCHIVE_CRITICAL) : ARCHIVE_CRITICAL;
+export function archiveRules(member = false, major = 3) {
+  const all = major >= 5 ? ARCHIVE_CRITICAL_5 : ARCHIVE_CRITICAL;
+  const CRITICAL = member ? withoutSkel(all) : all;
   let nextCritical = 0, notes = 0;
   return {
     entry(e) {
@@ -43,16 +46,18 @@ export function archiveRules(member = false) {
 }
 
 // 9.1.1: CLIP, IMAG, SKEL at entries 0, 1, 2; after them at most one NOTE and unknown
-// ancillary sections, in any order; nothing compressed; no section of the archive profile.
-export function runtimeRules(member = false) {
+// ancillary sections, in any order; nothing compressed; no section of the archive profile (in
+// version 5, QUAT neither: 9.1.2).
+export function runtimeRules(member = false, major = 4) {
   const SECTIONS = member ? withoutSkel(RUNTIME_SECTIONS) : RUNTIME_SECTIONS;
+  const ARCHIVE_ONLY = (major >= 5 ? ARCHIVE_CRITICAL_5 : ARCHIVE_CRITICAL).filter((t) => !RUNTIME_SECTIONS.includes(t));
   let count = 0, notes = 0;
   return {
     entry(e) {
       ++count;
       if (member) refuseMemberSkel(e);
       if (e.compressed) fail('corrupt', 'section table', e.entry + 4, `${e.where}: no section of the runtime profile is compressed`);
-      if (ARCHIVE_CRITICAL.includes(e.tag) && !RUNTIME_SECTIONS.includes(e.tag)) fail('corrupt', 'section table', e.entry, `${e.where}: the runtime profile holds no ${e.tag}`);
+      if (ARCHIVE_ONLY.includes(e.tag)) fail('corrupt', 'section table', e.entry, `${e.where}: the runtime profile holds no ${e.tag}`);
       if (e.index < SECTIONS.length) {
         const want = SECTIONS[e.index];
         if (e.tag !== want) fail('corrupt', 'section table', e.entry, `${e.where}: expected ${want} (the runtime profile's sections are ${SECTIONS.join(', ')} at entries 0 to ${SECTIONS.length - 1}, then NOTE or not)`);

@@ -2,7 +2,9 @@
 // and, for bones with position channels, local position (VectorKeyframeTrack), sampled from the
 // Cardinal curves (spec Appendix A, sample.js) at a grid of frame positions and made into local
 // transforms as spec Appendix B says (pose.js): rotation channels multiplied in channel order,
-// position channels replacing the Offset's component.
+// or for a quaternion node (version 5) its rotation from its stored x, y, z and its reference
+// (spec 4.7, rotation.js), position channels replacing the Offset's component. A track's
+// quaternions stay in one hemisphere from key to key (q and -q are the same rotation).
 //
 // three.js interpolates linearly between keys (slerp for rotations), the Cardinal curves do not:
 // between two keys the chord can leave the curve. So each interval of the grid is checked
@@ -11,6 +13,7 @@
 // budget. On a source-frame grid this adds keys where the motion bends fast for the budget.
 import { Quaternion, Vector3, QuaternionKeyframeTrack, VectorKeyframeTrack } from 'three';
 import { samplePose } from '../decoder/sample.js';
+import { storedRotation } from '../decoder/rotation.js';
 
 const DEG = Math.PI / 180;
 const AXES = [new Vector3(1, 0, 0), new Vector3(0, 1, 0), new Vector3(0, 0, 1)];
@@ -89,9 +92,12 @@ class Sampler {
       for (let c = 0; c < node.channels.length; ++c) {
         const type = node.channels[c], v = values[node.firstChannel + c];
         if (type < 3) { t[3 * i + type] = v; continue; }
+        if (node.quaternion) continue;  // below, from the three stored values
         this.axis.setFromAxisAngle(AXES[type - 3], v * DEG).toArray(tmp);
         multiply(q, 4 * i, tmp, 0, q, 4 * i);
       }
+      const quat = node.quaternion;
+      if (quat) storedRotation(quat.r, values[quat.column], values[quat.column + 1], values[quat.column + 2], q, 4 * i);
     }
   }
 
