@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "internal/next_float.h"
 #include "internal/trig.h"
 
 namespace {
@@ -103,3 +104,22 @@ TEST_CASE("round_to_int32 is cvtps2dq: edges, ties and a million random floats")
   CHECK(differ == 0);
 }
 #endif
+
+TEST_CASE("next_above is std::nextafter towards +infinity for finite values") {
+  std::vector<float> xs = {0.0f, -0.0f, 1.0f, -1.0f, 63.0f, 64.0f, 16777215.0f, -16777216.0f,
+                           std::numeric_limits<float>::denorm_min(), -std::numeric_limits<float>::denorm_min(),
+                           std::numeric_limits<float>::min(), -std::numeric_limits<float>::min(),
+                           std::numeric_limits<float>::max(), -std::numeric_limits<float>::max()};
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<uint32_t> bits;
+  while (xs.size() < 100000) {
+    const uint32_t b = bits(rng);
+    float x;
+    std::memcpy(&x, &b, sizeof x);
+    if (std::isfinite(x)) xs.push_back(x);
+  }
+  for (float x : xs) {
+    const float want = std::nextafter(x, std::numeric_limits<float>::infinity());
+    REQUIRE(same_bits(keyanim::internal::next_above(x), want));
+  }
+}

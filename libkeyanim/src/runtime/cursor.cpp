@@ -3,10 +3,12 @@
 // next segment costs one key).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 
 #include "internal/cpu.h"
+#include "internal/next_float.h"
 #include "internal/simd.h"
 #include "internal/simd8.h"
 #include "runtime/clip_access.h"
@@ -64,7 +66,7 @@ struct Slot {
 KEYANIM_INLINE inline Slot slot(Cursor::State& st, uint32_t i) noexcept { return {st.lanes[i >> 3], i & 7}; }
 
 // A state where curve i's value is `value` for lo <= f < hi.
-void set_direct(Slot s, float value, float lo, float hi) noexcept {
+KEYANIM_INLINE inline void set_direct(Slot s, float value, float lo, float hi) noexcept {
   SegmentLanes& g = s.g;
   const uint32_t l = s.l;
   g.lo[l] = lo, g.hi[l] = hi, g.value[l] = value;
@@ -78,7 +80,7 @@ void set_direct(Slot s, float value, float lo, float hi) noexcept {
 KEYANIM_INLINE inline bool position_stream(const Image& img, Cursor::State& st, uint32_t i, float f) noexcept {
   const float first = img.first_frame[i], last = img.last_frame[i];
   if (!(f > first)) {
-    set_direct(slot(st, i), img.first_value[i], -kInf, std::nextafter(first, kInf));
+    set_direct(slot(st, i), img.first_value[i], -kInf, next_above(first));
     return false;
   }
   if (f >= last) {
@@ -105,9 +107,9 @@ KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint
   if (exact_at_key) [[likely]] {
     g.lo[l] = k0, g.hi[l] = k1, g.direct[l] = 0u;
   } else if (f == k0) {
-    g.lo[l] = k0, g.hi[l] = std::nextafter(k0, kInf), g.direct[l] = ~0u, g.value[l] = o.p0;
+    g.lo[l] = k0, g.hi[l] = next_above(k0), g.direct[l] = ~0u, g.value[l] = o.p0;
   } else {
-    g.lo[l] = std::nextafter(k0, kInf), g.hi[l] = k1, g.direct[l] = 0u;
+    g.lo[l] = next_above(k0), g.hi[l] = k1, g.direct[l] = 0u;
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include "keyanim/clip.h"
 #include "runtime/image.h"
+#include "runtime/key_stream.h"
 #include "runtime/sampler.h"
 
 namespace keyanim {

@@ -1,5 +1,6 @@
-// The scalar pass of sampling (sampler.cpp, quat_tracks.cpp): where a position falls, and a
-// block's record read into its keys' frames and dequantized values. Internal to the runtime;
+// The scalar pass of sampling (sampler.cpp, quat_tracks.cpp, key_stream.h): where a position
+// falls, a block's record read into its keys' frames and dequantized values, a list's keys
+// around a position. Internal to the runtime;
 // everything here has internal linkage, so that each file's copies compiled for a CPU level
 // (internal/cpu.h) stay its own.
 #pragma once
@@ -21,7 +22,7 @@ struct Position {
   uint32_t block, t;
 };
 
-Position position(const Image& img, float f) noexcept {
+KEYANIM_INLINE inline Position position(const Image& img, float f) noexcept {
   Position p;
   p.f = f;
   if (img.block_count == 0) return {f, f, 0, 0};
@@ -84,7 +85,7 @@ struct BlockView {
   uint64_t upto;            // frames_upto(t): the block's keys at or before the position
 };
 
-BlockView block_view(const Image& img, const Position& at) noexcept {
+KEYANIM_INLINE inline BlockView block_view(const Image& img, const Position& at) noexcept {
   return {img.payload.data(), img.record_offset.data() + size_t(at.block) * img.block_tracks, img.curves.data(),
           frames_upto(at.t)};
 }
@@ -117,6 +118,31 @@ template <bool kPopcnt>
     base_at += cv[k]->base_bits;
     at += n * vw;
   }
+}
+
+// A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
+// first or last segment outside the keys), with virtual keys beyond the ends as in records.
+struct ListWindow {
+  int64_t frame[4];
+  float value[4];
+  uint32_t j;  // index of key j in the list
+};
+
+KEYANIM_INLINE inline void list_window(const Image& img, const ListSpan& list, float f, ListWindow& w) noexcept {
+  const uint32_t* k = img.list_frames.data() + list.first;
+  const float* v = img.list_values.data() + list.first;
+  const uint32_t n = list.count;
+  const float clamped = std::min(std::max(f, static_cast<float>(k[0])), static_cast<float>(k[n - 1]));
+  const uint32_t j = find_segment(k, n, clamped);
+  w.j = j;
+  w.frame[0] = j > 0 ? int64_t(k[j - 1]) : 2 * int64_t(k[0]) - int64_t(k[1]);
+  w.frame[1] = k[j];
+  w.frame[2] = k[j + 1];
+  w.frame[3] = j + 2 < n ? int64_t(k[j + 2]) : 2 * int64_t(k[n - 1]) - int64_t(k[n - 2]);
+  w.value[0] = v[j > 0 ? j - 1 : 0];
+  w.value[1] = v[j];
+  w.value[2] = v[j + 1];
+  w.value[3] = v[j + 2 < n ? j + 2 : n - 1];
 }
 
 }  // namespace

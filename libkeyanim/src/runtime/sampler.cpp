@@ -74,32 +74,8 @@ template <bool kPopcnt>
   gather_track<kPopcnt>(v, t.track, {t.track, T + t.track, 2 * T + t.track}, b, {i, i, i}, t.component);
 }
 
-// A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the
-// first or last segment outside the keys), with virtual keys beyond the ends as in records.
-struct ListWindow {
-  int64_t frame[4];
-  float value[4];
-  uint32_t j;  // index of key j in the list
-};
 
-void list_window(const Image& img, const ListSpan& list, float f, ListWindow& w) noexcept {
-  const uint32_t* k = img.list_frames.data() + list.first;
-  const float* v = img.list_values.data() + list.first;
-  const uint32_t n = list.count;
-  const float clamped = std::min(std::max(f, static_cast<float>(k[0])), static_cast<float>(k[n - 1]));
-  const uint32_t j = find_segment(k, n, clamped);
-  w.j = j;
-  w.frame[0] = j > 0 ? int64_t(k[j - 1]) : 2 * int64_t(k[0]) - int64_t(k[1]);
-  w.frame[1] = k[j];
-  w.frame[2] = k[j + 1];
-  w.frame[3] = j + 2 < n ? int64_t(k[j + 2]) : 2 * int64_t(k[n - 1]) - int64_t(k[n - 2]);
-  w.value[0] = v[j > 0 ? j - 1 : 0];
-  w.value[1] = v[j];
-  w.value[2] = v[j + 1];
-  w.value[3] = v[j + 2 < n ? j + 2 : n - 1];
-}
-
-void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b, uint32_t i) noexcept {
+KEYANIM_INLINE inline void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b, uint32_t i) noexcept {
   ListWindow w;
   list_window(img, img.lists[curve - img.block_curves], at.f, w);
   const int64_t start = int64_t(at.block) << kBlockShift;  // frames relative to f's block, as records
@@ -107,7 +83,7 @@ void gather_list(const Image& img, uint32_t curve, const Position& at, Batch& b,
   std::memcpy(b.values[i], w.value, sizeof w.value);
 }
 
-void set_fixed(Batch& b, uint32_t i, float v) noexcept {
+KEYANIM_INLINE inline void set_fixed(Batch& b, uint32_t i, float v) noexcept {
   std::memset(b.frames[i], 0, sizeof b.frames[i]);
   b.frames[i][2] = b.frames[i][3] = 1;
   std::memset(b.values[i], 0, sizeof b.values[i]);
@@ -118,7 +94,7 @@ void set_fixed(Batch& b, uint32_t i, float v) noexcept {
   b.linear[i] = 0;
 }
 
-void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept {
+KEYANIM_INLINE inline void copy_facts(const Image& img, uint32_t curve, Batch& b, uint32_t i) noexcept {
   b.s[i] = img.curve_s[curve];
   b.first_frame[i] = img.first_frame[curve];
   b.last_frame[i] = img.last_frame[curve];
@@ -411,48 +387,5 @@ void sample_range(const Image& img, float f, uint32_t first, uint32_t count, flo
   }
 }
 
-void seek_stream(const Image& img, uint32_t curve, float f, KeyStream& s) noexcept {
-  const Curve& cv = img.curves[curve];
-  if (curve >= img.block_curves) {  // a list curve: the stream walks the list
-    const ListSpan list = img.lists[curve - img.block_curves];
-    ListWindow w;
-    list_window(img, list, f, w);
-    for (int i = 0; i < 4; ++i) s.k[i] = static_cast<int32_t>(w.frame[i]), s.v[i] = w.value[i];
-    s.list = img.list_frames.data() + list.first;
-    s.list_values = img.list_values.data() + list.first;
-    s.list_count = list.count;
-    s.list_next = w.j + 3;
-    s.block = 0;
-    return;
-  }
-  s.list = nullptr;
-  const Position at = position(img, f);
-  CurveFields fl;
-  const uint8_t* rec = curve_record(img, at.block, curve, fl);
-  const uint64_t upto = frames_upto(at.t);
-  Window w;
-  const uint32_t below = window_frames<false>(rec, fl.mask, fl.context_at, fl.context_bits, upto, w.frame);
-  w.base = read_bits(rec, fl.base_at, cv.base_bits);
-  w.value_bits = fl.value_bits;
-  w.at = fl.values_at + uint64_t(below) * fl.value_bits;
-  float v[4];
-  dequantize4(rec, w, cv, v);
-  const int32_t start = static_cast<int32_t>(at.block << kBlockShift);
-  for (int i = 0; i < 4; ++i) s.k[i] = w.frame[i] + start, s.v[i] = v[i];
-  // Where key j+3 is: the block keys after key j+2, or the context keys after the block.
-  int32_t c[4];
-  read_context(rec, fl.context_at, fl.context_bits, c);
-  s.after[0] = c[2] + start, s.after[1] = c[3] + start;
-  const uint64_t above = fl.mask & ~upto;
-  const uint64_t above_rest = above & (above - 1);
-  s.rest = above_rest & (above_rest - 1);
-  s.after_used = above_rest ? 0 : above ? 1 : 2;
-  s.value_bits = w.value_bits;
-  s.next_at = fl.values_at + uint64_t(below + 4) * w.value_bits;
-  s.low = cv.q_base + static_cast<int64_t>(w.base);
-  s.block = static_cast<int32_t>(at.block);
-  s.rec = rec;
-  s.step = cv.step;
-}
 
 }  // namespace keyanim::internal
