@@ -10,7 +10,9 @@
 
 #include "internal/cpu.h"
 #include "internal/simd.h"
+#include "internal/simd8.h"
 #include "runtime/image.h"
+
 
 namespace keyanim::internal {
 namespace {
@@ -77,6 +79,44 @@ KEYANIM_INLINE inline Position position(const Image& img, float f) noexcept {
   for (int k = 0; k < 4; ++k) out[k] = dequantize(low + static_cast<int64_t>(value[k]), cv.step);
 }
 
+#if KEYANIM_WIDE_LANES
+// The AVX2 copies' usual case (vw <= 14, SSE2 above): the four values split by variable shifts
+// of one load in four 64-bit lanes, made doubles exactly (the bits of 2^52 + v, less 2^52),
+// then (low + v) x step rounded to binary32: the same operations, so the same bits, as above.
+// GCC vector extensions, as simd8.h's (no target attribute needed; vpsrlvq and 256-bit
+// doubles in the v3 copy).
+using V4u64 = uint64_t __attribute__((vector_size(32)));
+using V4f64 = double __attribute__((vector_size(32)));
+using V4f32 = float __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline void dequantize4_wide(const uint8_t* rec, uint64_t at, uint32_t vw, int64_t low,
+                                                    double step, float* out) noexcept {
+  uint64_t x;
+  std::memcpy(&x, rec + (at >> 3), 8);
+  x >>= at & 7;  // 4 vw + 7 <= 63 bits
+  const uint64_t w = vw, mask = (uint64_t(1) << vw) - 1;
+  const V4u64 v = (V4u64{x, x, x, x} >> V4u64{0, w, 2 * w, 3 * w}) & mask;
+  const uint64_t two52_bits = 0x4330000000000000u;  // 2^52
+  const V4f64 d = (V4f64)(v | two52_bits) - 4503599627370496.0;  // a vector cast keeps the bits
+  const V4f32 f = __builtin_convertvector((d + static_cast<double>(low)) * step, V4f32);
+  std::memcpy(out, &f, sizeof f);
+}
+#endif
+
+// dequantize4 in the AVX2 copies (kWide) where it can, else as above.
+template <bool kWide>
+[[gnu::always_inline]] inline void dequantize4_at(const uint8_t* rec, const Window& w, const Curve& cv,
+                                                  float* out) noexcept {
+#if KEYANIM_WIDE_LANES
+  if constexpr (kWide) {
+    if (w.value_bits <= 14) {
+      dequantize4_wide(rec, w.at, w.value_bits, cv.q_base + static_cast<int64_t>(w.base), cv.step, out);
+      return;
+    }
+  }
+#endif
+  dequantize4(rec, w, cv, out);
+}
+
 // The image's arrays for one block, loaded once per pose rather than once per curve.
 struct BlockView {
   const uint8_t* payload;
@@ -93,31 +133,35 @@ KEYANIM_INLINE inline BlockView block_view(const Image& img, const Position& at)
 // Quaternion track `track`'s curves x, y, z (their indices curve[0..2]): one search of the
 // shared mask gives every curve's window (their key frames are the same), into frame[0..4);
 // their Bases, then their Values, follow one another: curve k's four values into values[k]
-// (skipped where null).
-template <bool kPopcnt>
+// (skipped where null). Straight-line code for the three, so that their fields stay in
+// registers.
+template <bool kPopcnt, bool kWide = false>
 [[gnu::always_inline]] inline void read_track(const BlockView& v, uint32_t track, const uint32_t (&curve)[3],
                                               int32_t* frame, float* const (&values)[3]) noexcept {
   const uint8_t* rec = v.payload + v.offsets[track];
   uint64_t mask;
   std::memcpy(&mask, rec, 8);
   const uint32_t kw = rec[kTrackRecordBitsAt / 8 - 1];
-  Window w;
   const uint32_t count = window_frames<kPopcnt>(rec, mask, kTrackRecordBitsAt / 8, kw, v.upto, frame);
   const uint64_t n = popcount64<kPopcnt>(mask) + kContextKeys;  // values per curve
-  const Curve* cv[3] = {v.curves + curve[0], v.curves + curve[1], v.curves + curve[2]};
-  uint64_t base_at = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw;
-  uint64_t at = base_at + cv[0]->base_bits + cv[1]->base_bits + cv[2]->base_bits;
-  for (uint32_t k = 0; k < kTrackCurves; ++k) {
-    const uint32_t vw = rec[8 + k];
-    if (values[k] != nullptr) {
-      w.base = read_bits(rec, base_at, cv[k]->base_bits);
-      w.value_bits = vw;
-      w.at = at + uint64_t(count) * vw;
-      dequantize4(rec, w, *cv[k], values[k]);
-    }
-    base_at += cv[k]->base_bits;
-    at += n * vw;
-  }
+  const Curve& c0 = v.curves[curve[0]];
+  const Curve& c1 = v.curves[curve[1]];
+  const Curve& c2 = v.curves[curve[2]];
+  const uint32_t vw0 = rec[8], vw1 = rec[9], vw2 = rec[10];
+  const uint64_t base0 = kTrackRecordBitsAt + uint64_t(kContextKeys) * kw, base1 = base0 + c0.base_bits,
+                 base2 = base1 + c1.base_bits;
+  const uint64_t run0 = base2 + c2.base_bits, run1 = run0 + n * vw0, run2 = run1 + n * vw1;
+  auto one = [&](const Curve& cv, uint64_t base_at, uint64_t run_at, uint32_t vw, float* out) KEYANIM_INLINE {
+    if (out == nullptr) return;
+    Window w;
+    w.base = read_bits(rec, base_at, cv.base_bits);
+    w.value_bits = vw;
+    w.at = run_at + uint64_t(count) * vw;
+    dequantize4_at<kWide>(rec, w, cv, out);
+  };
+  one(c0, base0, run0, vw0, values[0]);
+  one(c1, base1, run1, vw1, values[1]);
+  one(c2, base2, run2, vw2, values[2]);
 }
 
 // A list curve's keys j-1 .. j+2 around f (j: the segment Appendix A finds, clamped to the

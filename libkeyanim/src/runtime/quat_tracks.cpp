@@ -105,7 +105,7 @@ KEYANIM_INLINE inline void track_group(const Image& img, const Position& at, con
   for (uint32_t j = 0; j < n; ++j) {
     const uint32_t t = t0 + j;
     float* values[3] = {b.values[0][j], b.values[1][j], b.values[2][j]};
-    read_track<kPopcnt>(view, t, {t, T + t, 2 * T + t}, b.frames[j], values);
+    read_track<kPopcnt, kWide>(view, t, {t, T + t, 2 * T + t}, b.frames[j], values);
   }
   // The facts from the image where its arrays hold the group's lanes (every group but the
   // last, and that one when whole), else copied.
