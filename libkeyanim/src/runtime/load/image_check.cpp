@@ -271,29 +271,29 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
       const uint64_t r = b * nt + t;
       const uint32_t curves = t < T ? kTrackCurves : 1;
       uint64_t curve[kTrackCurves] = {t < T ? t : t + 2 * T, T + t, 2 * T + t};  // its x, y, z, or its one
-      const std::string record = "record " + std::to_string(r);
+      auto record = [r] { return "record " + std::to_string(r); };  // made only for a message
       const uint64_t off_at = lay.at[L::record_offset] + 4 * r;
       if (at_index<uint32_t>(c, lay, L::record_offset, r) != running)
         return fail_in(Status::corrupt, c, off_at, "Record_Offset[" + std::to_string(r) + "] must be " + std::to_string(running) + ", where the previous record ends");
       const uint32_t header = (curves == 1 ? kRecordBitsAt : kTrackRecordBitsAt) / 8;
-      if (n.payload - running < header) return fail_in(Status::corrupt, c, off_at, record + " starts past the payload's end");
+      if (n.payload - running < header) return fail_in(Status::corrupt, c, off_at, record() + " starts past the payload's end");
       const uint8_t* rec = payload + running;
       uint64_t mask;
       std::memcpy(&mask, rec, 8);
       const uint32_t kw = rec[header - 1];
       for (uint32_t k = 0; k < curves; ++k)
         if (rec[8 + k] > kMaxValueBits)
-          return fail_in(Status::corrupt, c, payload_at + running + 8 + k, record + ": Value_Bits above 55");
+          return fail_in(Status::corrupt, c, payload_at + running + 8 + k, record() + ": Value_Bits above 55");
       if (kw > kMaxContextBits)
-        return fail_in(Status::corrupt, c, payload_at + running + header - 1, record + ": Context_Bits above 31");
-      if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, record + ": a key at or after Frame_Count");
+        return fail_in(Status::corrupt, c, payload_at + running + header - 1, record() + ": Context_Bits above 31");
+      if (mask & beyond) return fail_in(Status::corrupt, c, payload_at + running, record() + ": a key at or after Frame_Count");
       uint32_t base_bits[kTrackCurves];
       for (uint32_t k = 0; k < curves; ++k) base_bits[k] = load_le<uint32_t>(c.data + curve_at(curve[k]) + 16);
       const uint64_t bits = curve_fields(rec, 0, curves, base_bits).end;  // the widths read are within the payload
       const uint64_t size = (bits + 7) / 8;
-      if (size > n.payload - running) return fail_in(Status::corrupt, c, payload_at + running, record + " runs past the payload's end");
+      if (size > n.payload - running) return fail_in(Status::corrupt, c, payload_at + running, record() + " runs past the payload's end");
       if ((bits & 7) != 0 && (rec[size - 1] >> (bits & 7)) != 0)
-        return fail_in(Status::corrupt, c, payload_at + running + size - 1, record + ": the bits after its last field are not zero");
+        return fail_in(Status::corrupt, c, payload_at + running + size - 1, record() + ": the bits after its last field are not zero");
       const uint32_t m = static_cast<uint32_t>(__builtin_popcountll(mask));
       int32_t e[4];
       read_context(rec, header, kw, e);  // relative to the block's start; e[2], e[3] already + 64
@@ -302,13 +302,13 @@ Status Loader::check_image_records(const Content& c, const ImageLayout& lay, con
       const int32_t lo = m > 0 ? low_bit(mask) : e[2], hi = m > 0 ? top_bit(mask) : e[1];
       if (!(e[0] < e[1] && e[1] < lo && hi < e[2] && e[2] < e[3]))
         return fail_in(Status::corrupt, c, payload_at + running + header,
-                       record + ": its context frames are not two before and two after the block's keys, increasing");
+                       record() + ": its context frames are not two before and two after the block's keys, increasing");
       for (uint32_t k = 0; k < curves; ++k) {
         const uint64_t i = curve[k];
         const CurveFields f = curve_fields(rec, k, curves, base_bits);
         const int64_t base = static_cast<int64_t>(read_bits(rec, f.base_at, base_bits[k]));
         if (load_le<int64_t>(c.data + curve_at(i)) + base > kMaxAbsQ)
-          return fail_in(Status::corrupt, c, payload_at + running + header, record + ": Q_Base + Base is above 2^53");
+          return fail_in(Status::corrupt, c, payload_at + running + header, record() + ": Q_Base + Base is above 2^53");
         if (m == 0) continue;
         const float f0 = at_index<float>(c, lay, L::first_frame, i);
         if (seen[i] == 0 && f0 != float(start + low_bit(mask)))
