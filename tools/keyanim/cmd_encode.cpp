@@ -51,7 +51,7 @@ const char* const kEncodeHelp =
     "                        (ok, skipped, failed), bytes, max_error, tolerance, seconds\n"
     "  --runtime             write the runtime profile (format 5.0; 4.0 with --rotations euler):\n"
     "                        the image a player samples where it lies, loaded with no\n"
-    "                        decoding, about 1.8x the archive's bytes (`keyanim convert`\n"
+    "                        decoding, about twice the archive's bytes (`keyanim convert`\n"
     "                        turns either profile into the other)\n"
     "  --json                one JSON object on standard output (not with -o -); names that\n"
     "                        are not UTF-8 keep their bytes as \\udcHH escapes\n";
