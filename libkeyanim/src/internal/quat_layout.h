@@ -23,7 +23,7 @@ enum class Stored : uint8_t {
 };
 
 // The first column of `node`'s three rotation channels (the node must be quaternion_capable).
-inline uint32_t quat_column(const Skeleton& s, uint32_t node) noexcept {
+inline uint32_t first_quat_channel(const Skeleton& s, uint32_t node) noexcept {
   uint32_t first = 0;
   quaternion_capable(s.joints[node], &first);
   return s.joints[node].first_channel + first;
@@ -34,7 +34,7 @@ inline uint32_t quat_column(const Skeleton& s, uint32_t node) noexcept {
 inline std::vector<Stored> stored_kinds(const Skeleton& s, std::span<const QuatNode> nodes) {
   std::vector<Stored> out(s.channel_count(), Stored::value);
   for (const QuatNode& n : nodes) {
-    const uint32_t c = quat_column(s, n.node);
+    const uint32_t c = first_quat_channel(s, n.node);
     out[c] = Stored::quat_x, out[c + 1] = Stored::quat_y, out[c + 2] = Stored::quat_z;
   }
   return out;

@@ -222,7 +222,7 @@ std::string quat_problem(const EncodedClip& clip) {
     if (i > 0 && n.node <= clip.quat_nodes[i - 1].node) return where + "nodes not strictly increasing";
     if (!quaternion_capable(joints[n.node])) return where + "its node lacks three consecutive rotation channels about three axes";
     if (!internal::valid_reference(n.reference)) return where + "reference's x^2 + y^2 + z^2 above 1";
-    const uint32_t c = internal::quat_column(s, n.node);
+    const uint32_t c = internal::first_quat_channel(s, n.node);
     const EncodedChannel& x = clip.channels[c];
     for (uint32_t k = 1; k < 3; ++k) {
       const EncodedChannel& o = clip.channels[c + k];

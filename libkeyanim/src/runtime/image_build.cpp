@@ -265,7 +265,7 @@ namespace {
 // Whether the quaternion node's curves are block curves: a quaternion track (its three curves
 // have one key count: all block curves or none).
 bool is_quat_track(const ClipSource& src, const QuatNode& n, uint64_t blocks) {
-  const uint32_t keys = src.channels[quat_column(src.skeleton, n.node)].key_count;
+  const uint32_t keys = src.channels[first_quat_channel(src.skeleton, n.node)].key_count;
   return keys >= 2 && !is_list_curve(keys, blocks);
 }
 
@@ -275,7 +275,7 @@ bool is_quat_track(const ClipSource& src, const QuatNode& n, uint64_t blocks) {
 std::vector<uint32_t> curve_order(const ClipSource& src, uint64_t blocks, uint32_t& tracks) {
   std::vector<uint32_t> order, x;
   for (const QuatNode& n : src.quat_nodes)
-    if (is_quat_track(src, n, blocks)) x.push_back(quat_column(src.skeleton, n.node));
+    if (is_quat_track(src, n, blocks)) x.push_back(first_quat_channel(src.skeleton, n.node));
   tracks = static_cast<uint32_t>(x.size());
   for (uint32_t k = 0; k < kTrackCurves; ++k)
     for (uint32_t c : x) order.push_back(c + k);
@@ -331,7 +331,7 @@ void add_quat_arrays(const ClipSource& src, Arrays& a) {
       if (is_quat_track(src, n, blocks) != (tracks == 1)) continue;
       const size_t i = a.quat_node.size();
       a.quat_node.push_back(n.node);
-      a.quat_column.push_back(quat_column(src.skeleton, n.node));
+      a.quat_column.push_back(first_quat_channel(src.skeleton, n.node));
       float ref[4];
       reference_of(n, ref);
       for (size_t k = 0; k < 4; ++k) a.quat_reference[k * lanes + i] = ref[k];

@@ -105,7 +105,7 @@ ChannelLayout channel_layout(const Skeleton& s, const std::vector<QuatNode>& qua
   out.quats = quats;
   out.quat_of.assign(out.node.size(), UINT32_MAX);
   for (uint32_t i = 0; i < quats.size(); ++i) {
-    const uint32_t c = internal::quat_column(s, quats[i].node);
+    const uint32_t c = internal::first_quat_channel(s, quats[i].node);
     out.quat_of[c] = out.quat_of[c + 1] = out.quat_of[c + 2] = i;
   }
   return out;
@@ -158,7 +158,7 @@ void Signals::get(const Motion& m, const ChannelLayout& layout, uint32_t c, std:
 void Signals::get_quat(const Motion& m, const ChannelLayout& layout, uint32_t quat,
                        std::array<std::vector<double>, 4>& out) const {
   if (values_.empty()) return quat_signals(m, layout.quats[quat], out);
-  const uint32_t c = internal::quat_column(m.skeleton, layout.quats[quat].node);
+  const uint32_t c = internal::first_quat_channel(m.skeleton, layout.quats[quat].node);
   for (uint32_t k = 0; k < 3; ++k) get(m, layout, c + k, out[k]);
   out[3].resize(frames_);
   for (uint32_t f = 0; f < frames_; ++f) {

@@ -133,7 +133,7 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
     const bool ordered = i == 0 || i == T || node > nodes[i - 1].node;
     if (node >= skeleton.joints.size() || !ordered || !quaternion_capable(skeleton.joints[node]))
       return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "] must be a node with three consecutive rotation channels about three axes, the tracks' first, each group increasing");
-    const uint32_t column = quat_column(skeleton, node);
+    const uint32_t column = first_quat_channel(skeleton, node);
     if (at_index<uint32_t>(c, lay, L::quat_column, i) != column)
       return fail_in(Status::corrupt, c, lay.at[L::quat_column] + 4 * i, "Quat_Column[" + std::to_string(i) + "] is not its node's first rotation channel");
     const uint32_t keys = at_index<uint32_t>(c, lay, L::key_count, column);
