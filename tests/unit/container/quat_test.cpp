@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <numbers>
 #include <vector>
 
 #include "clips.h"
@@ -18,8 +17,6 @@ using keyanim::QuatNode;
 using keyanim::Transform;
 
 namespace {
-
-constexpr double kRad = std::numbers::pi / 180.0;
 
 // The rotation angle between unit quaternions a and b (either sign), in radians: 4 asin of half
 // the chord, which keeps its digits for small angles (2 acos of the dot product does not).
