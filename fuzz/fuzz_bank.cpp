@@ -24,9 +24,11 @@
 //    loader promises, key frames strictly increasing and below the frame count, finite key
 //    values; it samples (positions around both ends, between frames, block boundaries, local
 //    and model poses, a cursor's forward playback) bit for bit as eval_channel (cardinal.h,
-//    Appendix A) on its keys, the cursor as without one, the viewed bank's clip as the opened
-//    one's, with finite values where the keys leave no room for an overflow; clips of one
-//    skeleton share a rig; the opened bank's clips still sample after the bank is gone.
+//    Appendix A) on its keys (a quaternion node's channels, version 5: the Euler angles of its
+//    stored x, y, z so evaluated; sample_stored: those values), the cursor as without one, the
+//    viewed bank's clip as the opened one's, with finite values where the keys leave no room
+//    for an overflow; clips of one skeleton share a rig; the opened bank's clips still sample
+//    after the bank is gone.
 // Work per input is capped (kMaxClips clips loaded, kSampleBudget values sampled), so that a
 // bank declaring many clips of many channels stays fast; the index checks are not capped.
 #include <algorithm>
@@ -73,7 +75,7 @@ void put_le64(uint8_t* p, uint64_t v) {
 void repair(uint8_t* b, size_t size) {
   if (size < 40) return;
   const uint64_t minor = le(b + 10, 2), clips = le(b + 16, 4), skeletons = le(b + 20, 4);
-  const uint64_t clip_table = 40 + 16 * skeletons;
+  const uint64_t clip_table = 40 + 32 * skeletons;  // skeleton table entries of 32 bytes (10.3)
   if ((minor & 0x4000) == 0) {
     for (uint64_t i = 0; i < std::min<uint64_t>(clips, kMaxClips); ++i) {
       const uint64_t e = clip_table + 40 * i;
@@ -213,12 +215,15 @@ std::vector<float> sample_checked(const Clip& clip, const std::vector<keyanim::t
   float largest = 0.0f;  // |key value|: Hermite segments stay within a few times it
   for (const auto& k : keys)
     for (float v : k.values) largest = std::max(largest, std::fabs(v));
-  std::vector<float> out, pose(channels);
+  std::vector<float> out, pose(channels), stored(channels);
   std::vector<Transform> xf(clip.skeleton().joints.size());
+  const keyanim::test::SampleReference ref = keyanim::test::sample_reference(clip, keys);
   for (double x : positions(clip)) {
     FUZZ_CHECK(clip.sample(x, pose) == Status::ok);
-    for (uint32_t c = 0; c < channels; ++c) {
-      FUZZ_CHECK(keyanim::fuzz::same_float(pose[c], keyanim::test::reference_value(clip, keys[c], static_cast<float>(x))));
+    FUZZ_CHECK(clip.sample_stored(x, stored) == Status::ok);
+    for (uint32_t c = 0; c < channels; ++c) {  // a quaternion node's channels: its Euler angles
+      FUZZ_CHECK(keyanim::fuzz::same_float(pose[c], keyanim::test::reference_sample(clip, ref, c, static_cast<float>(x))));
+      FUZZ_CHECK(keyanim::fuzz::same_float(stored[c], keyanim::test::reference_value(clip, keys[c], static_cast<float>(x))));
       FUZZ_CHECK(std::isfinite(pose[c]) || largest > 1e30f);
     }
     out.insert(out.end(), pose.begin(), pose.end());

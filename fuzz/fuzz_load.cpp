@@ -6,7 +6,9 @@
 // and the data justify (run with -malloc_limit_mb); a failure leaves the clip
 // empty with an error naming a section and an offset inside the file; a success gives arrays
 // that keep every promise the sampler relies on (key frames strictly increasing and below
-// frame_count, finite key values, tracks covering the key arrays, channels = skeleton's).
+// frame_count, finite key values, tracks covering the key arrays, channels = skeleton's;
+// quaternion nodes, version 5, in node order, each quaternion_capable, their channels reported
+// as stored x, y, z and no other channel so).
 // A runtime-profile file (spec section 9) is checked for its structure only, unless
 // DecodeLimits::check_content: its key values may then be infinite (a Step of 1e300, say),
 // which section 9.4 leaves to the content rules. Such a file is loaded a second time with
@@ -65,6 +67,27 @@ void check_loaded(const Clip& clip, bool finite) {
     }
   }
   FUZZ_CHECK(keys == clip.total_keys());
+  // Quaternion nodes (version 5, section 4.7): in strictly increasing node order, each with
+  // three rotation channels about three axes, which channel() reports as its stored x, y, z;
+  // every other channel holds its own values.
+  FUZZ_CHECK(clip.quat_node_count() == 0 || clip.version_major() >= 5);
+  uint32_t quat_channels = 0;
+  for (uint32_t i = 0; i < clip.quat_node_count(); ++i) {
+    const keyanim::QuatNode q = clip.quat_node(i);
+    FUZZ_CHECK(q.node < joints.size());
+    if (i > 0) FUZZ_CHECK(q.node > clip.quat_node(i - 1).node);
+    const double r2 = double(q.reference[0]) * q.reference[0] + double(q.reference[1]) * q.reference[1] +
+                      double(q.reference[2]) * q.reference[2];
+    FUZZ_CHECK(r2 <= 1073741824.0);
+    uint32_t at = 0;
+    FUZZ_CHECK(keyanim::quaternion_capable(joints[q.node], &at));
+    for (uint32_t k = 0; k < 3; ++k)
+      FUZZ_CHECK(clip.channel(joints[q.node].first_channel + at + k).stored == static_cast<keyanim::StoredAs>(k + 1));
+    quat_channels += 3;
+  }
+  for (uint32_t c = 0; c < channels; ++c)
+    if (clip.channel(c).stored != keyanim::StoredAs::value) --quat_channels;
+  FUZZ_CHECK(quat_channels == 0);
   // The sampler on the clip just loaded: one pose at its first and last frame.
   std::vector<float> pose(channels);
   FUZZ_CHECK(clip.sample(0.0, pose) == Status::ok);

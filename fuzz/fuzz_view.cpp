@@ -14,7 +14,9 @@
 //    The clip loaded from the same bytes (a copy of them) must give the same bits.
 //  * Clip::load with check_content: a failure is `corrupt` in IMAG; a success means the image
 //    is the one its keys make, so the viewed clip must then sample, with or without a cursor,
-//    bit for bit as the loaded clip and as eval_channel (cardinal.h, Appendix A) on its keys.
+//    bit for bit as the loaded clip and as eval_channel (cardinal.h, Appendix A) on its keys (a
+//    quaternion node of version 5: its channels the Euler angles of its stored x, y, z so
+//    evaluated, sample_stored those values, its local rotation their binary32 stored_rotation).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -162,7 +164,9 @@ std::vector<keyanim::test::ChannelKeys> keys_of(const Clip& clip) {
 }
 
 // The viewed clip whose image passed the content check: every value is eval_channel's on its
-// keys, which are the loaded clip's.
+// keys, which are the loaded clip's (a quaternion node's rotation channels: the Euler angles of
+// its stored x, y, z so evaluated; sample_stored: those values; its local rotation: the binary32
+// stored_rotation of them, rotation.h, whichever path, a track's or a curve's, computed it).
 void check_against_reference(const Clip& viewed, const Clip& checked, const Samples& sv) {
   const auto keys = keys_of(viewed), checked_keys = keys_of(checked);
   FUZZ_CHECK(keys.size() == checked_keys.size());
@@ -174,10 +178,27 @@ void check_against_reference(const Clip& viewed, const Clip& checked, const Samp
   FUZZ_CHECK(same_floats(sv.playback, sv.plain));
   const uint32_t channels = viewed.channel_count();
   if (channels == 0) return;
+  const keyanim::test::SampleReference ref = keyanim::test::sample_reference(viewed, keys);
   size_t at = 0;
   for (double x : positions(viewed))
     for (uint32_t c = 0; c < channels; ++c, ++at)
-      FUZZ_CHECK(keyanim::fuzz::same_float(sv.values[at], keyanim::test::reference_value(viewed, keys[c], static_cast<float>(x))));
+      FUZZ_CHECK(keyanim::fuzz::same_float(sv.values[at], keyanim::test::reference_sample(viewed, ref, c, static_cast<float>(x))));
+  std::vector<float> stored(channels);
+  std::vector<Transform> xf(viewed.skeleton().joints.size());
+  for (double x : positions(viewed)) {
+    FUZZ_CHECK(viewed.sample_stored(x, stored) == Status::ok);
+    for (uint32_t c = 0; c < channels; ++c)
+      FUZZ_CHECK(keyanim::fuzz::same_float(stored[c], keyanim::test::reference_value(viewed, keys[c], static_cast<float>(x))));
+    if (ref.quats.empty()) continue;
+    FUZZ_CHECK(viewed.sample_local(x, xf) == Status::ok);
+    for (const keyanim::test::QuatChannels& q : ref.quats) {
+      float r[4], want[4];
+      keyanim::reference_of(q.node, r);
+      keyanim::stored_rotation<float>(r, stored[q.first], stored[q.first + 1], stored[q.first + 2], want,
+                                      [](float v) { return std::sqrt(v); }, [](float v) { return v > 0.0f ? v : 0.0f; });
+      for (int k = 0; k < 4; ++k) FUZZ_CHECK(keyanim::fuzz::same_float(xf[q.node.node].rotation[k], want[k]));
+    }
+  }
 }
 
 }  // namespace

@@ -2,8 +2,11 @@
 // data/'s two CMU files and from tests/data/bvh fixtures (two roots, mixed rotation orders, one
 // frame), in both profiles, with and without a dictionary, with sections stored raw (so that
 // mutations reach the member parsers' fields), one clip, no clip, and many clips with names
-// sharing prefixes (the name order's binary search). Each seed stays under 64 KiB, the -max_len
-// CI runs with. Run through make_seeds.py --bank; usage: make_bank_seeds REPO_DIR OUT_DIR
+// sharing prefixes (the name order's binary search). Those clips keep Euler rotations (members
+// of version 4, banks of 4.1, as the seeds were first made); the quat_ banks (version 5.0) hold
+// the CMU clips with quaternion nodes (spec 4.7), alone and beside the Euler ones (members of
+// versions 5 and 4 in one bank). Each seed stays under 64 KiB, the -max_len CI runs with. Run
+// through make_seeds.py --bank; usage: make_bank_seeds REPO_DIR OUT_DIR
 #include <cstdio>
 #include <cstddef>
 #include <exception>
@@ -28,8 +31,9 @@ off::Motion cut(const off::Motion& m, uint32_t from, uint32_t count) {
   return c;
 }
 
-off::EncodedClip encode(const off::Motion& m, bool coarse) {
+off::EncodedClip encode(const off::Motion& m, bool coarse, bool quaternion = false) {
   off::EncodeSettings s;
+  s.rotations = quaternion ? off::Rotations::quaternion : off::Rotations::euler;
   if (coarse) {  // fewer keys: a smaller seed
     s.key_mode = off::KeyMode::uniform;
     s.uniform_interval = 5;
@@ -99,6 +103,23 @@ int main(int argc, char** argv) try {
   }
   write(out, "many_clips_archive_raw.kbank", many, raw);
   write(out, "many_clips_runtime.kbank", many, runtime);
+  // Version 5.0: the CMU clips with quaternion nodes, then beside an Euler clip of each skeleton
+  // (a skeleton's clips share it whatever their rotations).
+  const std::vector<off::BankInput> quat = {
+      {"walk/start", encode(cut(walk, 0, 12), true, true)},
+      {"hop", encode(cut(hop, 0, 10), true, true)},
+      {"walk/end", encode(cut(walk, 100, 8), false, true)},
+  };
+  for (const off::BankInput& c : quat)
+    if (c.clip.quat_nodes.empty()) throw std::runtime_error(c.name + ": no quaternion node");
+  std::vector<off::BankInput> mixed = quat;
+  mixed.push_back({"walk/euler", cmu[2].clip});
+  mixed.push_back({"hop/euler", encode(cut(hop, 20, 6), true)});
+  write(out, "quat_archive.kbank", quat, archive);
+  write(out, "quat_archive_raw.kbank", quat, raw);
+  write(out, "quat_runtime.kbank", quat, runtime);
+  write(out, "quat_mixed_archive_dictionary.kbank", mixed, dictionary);
+  write(out, "quat_mixed_runtime.kbank", mixed, runtime);
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "make_bank_seeds: %s\n", e.what());

@@ -9,18 +9,29 @@ usage: fuzz/make_seeds.py KEYANIM_BINARY [SHARED_CORPUS_DIR]
  - bvh/:       tests/data/bvh fixtures, data/*.bvh and CMU clips of the shared corpus cut to 3 frames
  - roundtrip/: a settings byte + BVH snippets of at most 2000 values (see fuzz_roundtrip.cpp)
  - load/:      spec/test-vectors/*.kanim and .kanim files encoded (by KEYANIM_BINARY) from snippets,
-               each also with its sections stored uncompressed (zstd CLI)
- - sample/:    request records + those .kanim files (see fuzz_sample.cpp); fuzz_c_api reads them too
- - view/:      view_seeds(): spec/test-vectors/v4_*.kanim (the runtime profile) and the runtime
-               profile (keyanim convert --runtime) of load/'s CMU seeds, those encoded at the
-               default error and at 1% with uniform:5 keys (the _raw ones are the same clips)
- - bank/:      bank_seeds(): banks written by write_bank (make_bank_seeds.cpp says which); not
-               part of a plain run, since the helper is a C++ program of the build, not the CLI
+               each also with its sections stored uncompressed (zstd CLI): every snippet with
+               Euler rotations (--rotations euler: version 3.0, as the seeds were first made), the
+               two of data/ also with quaternion nodes (_quat: version 5.0, what encode writes by
+               default since format 5)
+ - sample/:    request records + those .kanim files (see fuzz_sample.cpp; not for a file of 64 KiB
+               or more, spec/test-vectors/v4_blocks.kanim); fuzz_c_api reads them too
+ - view/:      view_seeds(): spec/test-vectors/v4_*.kanim and v5_*.kanim (the runtime profile, and
+               the archive files of those versions, which view decodes too) and the runtime profile
+               (keyanim convert --runtime) of load/'s CMU seeds, those encoded at the default error
+               and at 1% with uniform:5 keys (the _raw ones are the same clips), and of the _quat
+               ones (version 5.0)
+ - bank/:      bank_seeds(): banks written by write_bank (make_bank_seeds.cpp says which; the
+               quat_ ones of version 5.0) and the spec's bank vectors (spec/test-vectors/*.kbank,
+               as vector_*.kbank); not part of a plain run, since the helper is a C++ program of
+               the build, not the CLI
  - c_api/:     c_api_seeds(): a few of sample/'s seeds with every fuzz_c_api request kind, loaded
-               with the CRC-32 as given (byte 0 >= 231): intact, a byte flipped, cut short
+               with the CRC-32 (a runtime file's XXH64) as given (byte 0 >= 231): intact, a byte
+               flipped, cut short
 
 Only CMU clips are used from the shared corpus (their terms allow it); never bandai/ or ManipNet.
 Crash inputs found later are added by hand as crash-<what>.* files and never regenerated.
+The encoder's output changes with its versions, so a run rewrites the encoded seeds with other
+(equally valid) bytes; commit only the files a change is about.
 """
 import os
 import random
@@ -73,6 +84,12 @@ def uncompressed(kanim: bytes) -> bytes:
     return body + struct.pack("<I", zlib.crc32(body))
 
 
+# Snippets also encoded with quaternion nodes (version 5.0): the two CMU clips of data/.
+QUAT_SNIPPETS = ("data_cmu_02_01_walk", "data_cmu_131_03_hop")
+# libFuzzer's -max_len in CI (scripts/sanitize.sh) and in README.md: a longer seed is cut there.
+MAX_SEED = 65536
+
+
 def write(path: str, data: bytes) -> None:
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(path, "wb") as f:
@@ -123,16 +140,24 @@ def main() -> None:
         for key, bvh in sorted(snippets.items()):
             src, dst = os.path.join(tmp, key + ".bvh"), os.path.join(tmp, key + ".kanim")
             write(src, bvh)
-            for label, extra in (("", []), ("_coarse", ["--error", "1%", "--keys", "uniform:5"])):
+            coarse = ["--error", "1%", "--keys", "uniform:5"]
+            variants = [("", ["--rotations", "euler"]), ("_coarse", ["--rotations", "euler"] + coarse)]
+            if key in QUAT_SNIPPETS:
+                variants += [("_quat", ["--rotations", "quaternion"]), ("_quat_coarse", ["--rotations", "quaternion"] + coarse)]
+            for label, extra in variants:
                 r = subprocess.run([keyanim, "-q", "-f", "encode", src, "-o", dst] + extra, capture_output=True)
                 if r.returncode == 0:
                     with open(dst, "rb") as f:
                         kanims[key + label] = f.read()
                     kanims[key + label + "_raw"] = uncompressed(kanims[key + label])
-                elif label == "":
+                elif label in ("", "_quat"):
                     sys.exit("encode failed for %s: %s" % (key, r.stderr.decode()))
+                if label == "_quat" and kanims[key + label][8] != 5:
+                    sys.exit("%s: not a version 5 file (no quaternion node?)" % (key + label))
     for key, data in sorted(kanims.items()):
         write(os.path.join(corpus, "load", key + ".kanim"), data)
+        if len(data) >= MAX_SEED:
+            continue
         records = b""
         for mode in range(16):  # every request kind once, then a few random ones
             m = rng.randrange(256) if mode >= 8 else mode | (rng.randrange(8) << 3) | (rng.randrange(2) << 6)
@@ -146,12 +171,12 @@ def view_seeds(keyanim, corpus):
     """fuzz_view's seeds: runtime-profile files (see fuzz_view.cpp)."""
     vectors = os.path.join(ROOT, "spec", "test-vectors")
     for name in sorted(os.listdir(vectors)):
-        if name.startswith("v4_") and name.endswith(".kanim"):
+        if name.startswith(("v4_", "v5_")) and name.endswith(".kanim"):
             with open(os.path.join(vectors, name), "rb") as f:
                 write(os.path.join(corpus, "view", "vector_" + name), f.read())
     load = os.path.join(corpus, "load")
     for name in sorted(os.listdir(load)):
-        if re.fullmatch(r"cmu_[0-9a-z_-]+?(_coarse)?\.kanim", name) and "_raw" not in name:
+        if re.fullmatch(r"(cmu_[0-9a-z_-]+?|[0-9a-z_-]+_quat)(_coarse)?\.kanim", name) and "_raw" not in name:
             dst = os.path.join(corpus, "view", name[:-6] + "_runtime.kanim")
             subprocess.run([keyanim, "-q", "-f", "convert", os.path.join(load, name), "--runtime", "-o", dst],
                            check=True)
@@ -163,15 +188,21 @@ def bank_seeds(helper, corpus):
     out = os.path.join(corpus, "bank")
     os.makedirs(out, exist_ok=True)
     subprocess.run([helper, ROOT, out], check=True)
+    vectors = os.path.join(ROOT, "spec", "test-vectors")
+    for name in sorted(os.listdir(vectors)):
+        if name.endswith(".kbank"):
+            with open(os.path.join(vectors, name), "rb") as f:
+                write(os.path.join(out, "vector_" + name), f.read())
 
 
 def c_api_seeds(corpus):
     """fuzz_c_api's own seeds, made from sample/'s: 24 requests (byte 0 = 255: 255 % 33 = 24,
-    and >= 231, so that the CRC-32 is kept) of every kind (channels, local, model; by frame or
+    and >= 231, so that the checksum is kept) of every kind (channels, local, model; by frame or
     time; cursor; short buffer; each way of making a position), on the file as it is, with a
     byte flipped and cut short."""
     rng = random.Random(26)
-    for key in ("vector_v3_rules", "data_cmu_02_01_walk_coarse", "data_cmu_131_03_hop_coarse_raw"):
+    for key in ("vector_v3_rules", "data_cmu_02_01_walk_coarse", "data_cmu_131_03_hop_coarse_raw", "vector_v5_quat",
+                "vector_v5_quat_runtime"):
         with open(os.path.join(corpus, "sample", key + ".bin"), "rb") as f:
             seed = f.read()
         data = seed[1 + 16 * 9:]
