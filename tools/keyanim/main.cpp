@@ -6,6 +6,9 @@
 #include <new>
 #include <optional>
 #include <string>
+#ifdef __GLIBC__
+#include <malloc.h>  // mallopt
+#endif
 
 #include "commands.h"
 #include "escape.h"
@@ -169,6 +172,15 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   using namespace keyanim::cli;
+#ifdef __GLIBC__
+  // glibc's default mmap threshold (128 KiB), kept fixed: by default it rises to the size of the
+  // largest block freed, after which the encoder's per-round vectors of a long clip (hundreds of
+  // KiB each, of changing sizes) fragment the heap instead of going back to the system. A
+  // quaternion encode of the 44,032-frame clip peaked at 3.40x its BVH's bytes so, 2.8x with it
+  // (bench_codec's peak_rss_over_bvh_bytes). A process-wide policy: the command's, not the
+  // library's to set.
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
   install_interrupt_cleanup();
   Failure failure;
   try {
