@@ -30,13 +30,13 @@ const Image& empty_image() {
     r.hash = internal::rig_hash(r.skeleton);
     return r;
   }();
-  static const Image kEmpty = [] {
-    Image i;
+  static const Image* const kEmpty = [] {  // made in place: an Image is not copied
+    static Image i;
     i.rig = std::shared_ptr<const internal::Rig>(std::shared_ptr<const internal::Rig>(), &kEmptyRig);
     i.euler = &kEmptyRig.euler;
-    return i;
+    return &i;
   }();
-  return kEmpty;
+  return *kEmpty;
 }
 
 }  // namespace

@@ -4,8 +4,9 @@
 // the file format and may change between library versions).
 //
 // Time is cut into blocks of kBlockFrames frames. For every block and every channel with two
-// keys or more (a "curve"), one record holds the channel's keys inside the block plus two keys
-// before and two after it: every key any position inside the block can need (a segment's two
+// keys or more (a "curve") that is not a list curve, one record holds the curve's keys inside
+// the block plus two keys before and two after it (a quaternion track's record: its three
+// curves', below): every key any position inside the block can need (a segment's two
 // ends and their outer neighbours). Beyond the channel's first or last key, virtual keys
 // repeat the end value at the end segment's spacing, which gives exactly the end rules of
 // Appendix A (P_{-1} = P_0, tangent scale 1). So a record is self-contained: sampling one
@@ -29,6 +30,7 @@
 // track t's curves are t, T + t and 2T + t (T tracks: their x's, then their y's, then their
 // z's, before every other curve), so that the facts of 4 or 8 tracks load at once.
 #pragma once
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -83,6 +85,11 @@ struct ListSpan {
 // Clip::load (owned too), or caller-owned bytes viewed by Clip::view (no owner: the caller keeps
 // them alive). Either way the sampler reads the same layout.
 struct Image {
+  // Not copied or moved: `euler` may point at this image's own `own_euler`.
+  Image() = default;
+  Image(const Image&) = delete;
+  Image& operator=(const Image&) = delete;
+
   // The clip.
   uint16_t version_major = 0, version_minor = 0;
   uint32_t frame_count = 0;
@@ -246,9 +253,6 @@ inline int32_t unzigzag32(uint64_t u) noexcept {
   c[2] += static_cast<int32_t>(kBlockFrames);
   c[3] += static_cast<int32_t>(kBlockFrames);
 }
-[[gnu::always_inline]] inline void read_context(const uint8_t* rec, uint32_t kw, int32_t* c) noexcept {
-  read_context(rec, kRecordBitsAt / 8, kw, c);
-}
 
 // Bits 0..t set: the frames of a block at or before block_start + t.
 inline uint64_t frames_upto(uint32_t t) noexcept { return t >= 63 ? ~uint64_t(0) : (uint64_t(2) << t) - 1; }
@@ -342,16 +346,22 @@ inline const uint8_t* curve_record(const Image& img, uint32_t block, uint32_t cu
   return rec;
 }
 
-// The index in img's quaternion arrays of its i-th quaternion node in node order (the arrays
-// list the tracks, then the others, each group in node order): a merge of the two, O(Q).
+// The index in img's quaternion arrays of its i-th quaternion node in node order (i < Q). The
+// arrays list the tracks (A), then the others (B), each group in strictly increasing node order
+// and no node in both (9.4); a binary search finds a, how many of A come before the i-th of the
+// merge, in O(log Q): callers ask for every i, and Q reaches the node limit.
 inline uint32_t quat_in_node_order(const Image& img, uint32_t i) noexcept {
-  uint32_t a = 0, b = img.quat_tracks;
-  const uint32_t end = static_cast<uint32_t>(img.quat_node.size());
-  for (uint32_t k = 0;; ++k) {
-    const bool take_a = a < img.quat_tracks && (b == end || img.quat_node[a] < img.quat_node[b]);
-    if (k == i) return take_a ? a : b;
-    take_a ? ++a : ++b;
+  const uint32_t* node = img.quat_node.data();
+  const uint32_t na = img.quat_tracks, nb = static_cast<uint32_t>(img.quat_node.size()) - na;
+  const uint32_t* b = node + na;
+  uint32_t lo = i > nb ? i - nb : 0, hi = std::min(i, na);
+  while (lo < hi) {  // the first a such that A[a] is after B[i - a - 1]
+    const uint32_t mid = lo + (hi - lo) / 2;
+    if (node[mid] < b[i - mid - 1]) lo = mid + 1;
+    else hi = mid;
   }
+  const uint32_t j = i - lo;  // how many of B come before it
+  return lo < na && (j >= nb || node[lo] < b[j]) ? lo : na + j;
 }
 
 // The window's four values (see Window).

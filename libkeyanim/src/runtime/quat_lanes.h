@@ -41,11 +41,16 @@ KEYANIM_INLINE inline void store_rotations(const QuatLanes<F8>& q, const uint32_
 #endif
 
 // The rotations of the image's quaternion nodes i .. i + lanes - 1 (lanes <= V's) from their
-// stored x, y, z in registers: stored_rotation in every lane, out[node - first]. Padding lanes
-// (x, y, z 0, the identity reference) are computed and not stored.
+// stored x, y, z in registers: stored_rotation in every lane, out[node - first]. Lanes past
+// `lanes` are computed and not stored: their references are the identity padding, or, where
+// i + V's lanes passes quat_lanes (i need not be a multiple of 4 in a partial pose), the next
+// row's floats and, for the w row, up to 7 floats after Quat_Reference. Those lie inside IMAG,
+// whose Record_Offset array follows with a tail of 8 entries (asserted below), so no load
+// leaves the image's bytes, and no branch is taken per group for it.
 template <class V>
 KEYANIM_INLINE inline void store_quat_rotations(const Image& img, uint32_t i, uint32_t lanes, const V& x, const V& y,
                                                 const V& z, uint32_t first, Transform* out) noexcept {
+  static_assert(sizeof(V) - sizeof(float) <= 4 * kImageTailEntries, "a w-row load may pass Quat_Reference's end");
   const float* ref = img.quat_reference.data() + i;
   const V r[4] = {V::load(ref), V::load(ref + img.quat_lanes), V::load(ref + 2 * size_t(img.quat_lanes)),
                   V::load(ref + 3 * size_t(img.quat_lanes))};

@@ -230,9 +230,11 @@ template <bool kPopcnt, bool kWide>
   run_chunks<kWide>(img, at, block_view(img, at), 0, count, fill, facts, emit);
 }
 
-// A record's largest size in bytes (spec 9.3: 10 bytes, four contexts of up to 31 bits, a base
-// and 68 values of up to 55 bits: 500), rounded up: a block's records take at most this many
-// per curve, which bounds the range asked for when a hostile file's offsets are far apart.
+// A record's largest size per curve in bytes, rounded up (spec 9.3: a curve's record is 10
+// bytes, four contexts of up to 31 bits, a base and 68 values of up to 55 bits: 500; a
+// quaternion track's, 12 bytes, the contexts, three bases and 3 x 68 values: 1,451 for its three
+// curves, 484 each): a block's records take at most this many per curve, which bounds the range
+// asked for when a hostile file's offsets are far apart.
 constexpr uint64_t kRecordBytesBound = 512;
 
 // What a pose of every curve reads, asked for at once: the loops below read each array a few

@@ -3,14 +3,17 @@
 // from them, each checked against an independent computation.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
 #include "clips.h"
 #include "crafted.h"
 #include "keyanim/offline/fk.h"
 #include "keyanim/rotation.h"
+#include "runtime/image.h"
 
 using namespace container_test;
 using keyanim::QuatNode;
@@ -170,6 +173,32 @@ TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its
   CHECK(worst_pose < 2e-6);    // binary32 arithmetic
   CHECK(worst_angles < 2e-6);  // angles rounded to binary32 degrees
   CHECK(worst_angles > 0.0);
+}
+
+TEST_CASE("quat_in_node_order is the merge of the tracks' and the others' node lists") {
+  // Every split of node sets drawn from 0..11 into tracks and others, each group increasing:
+  // the binary search against the two lists merged by hand.
+  std::mt19937 rng(5);
+  for (int round = 0; round < 2000; ++round) {
+    std::vector<uint32_t> tracks, others;
+    for (uint32_t node = 0; node < 12; ++node) {
+      const uint32_t where = static_cast<uint32_t>(rng() % 3);  // 0: not a quaternion node
+      if (where == 1) tracks.push_back(node);
+      if (where == 2) others.push_back(node);
+    }
+    std::vector<uint32_t> nodes = tracks;
+    nodes.insert(nodes.end(), others.begin(), others.end());
+    keyanim::internal::Image img;
+    img.quat_node = nodes;
+    img.quat_tracks = static_cast<uint32_t>(tracks.size());
+    std::vector<uint32_t> merged = nodes;
+    std::sort(merged.begin(), merged.end());
+    for (uint32_t i = 0; i < merged.size(); ++i) {
+      CAPTURE(round);
+      CAPTURE(i);
+      CHECK(nodes[keyanim::internal::quat_in_node_order(img, i)] == merged[i]);
+    }
+  }
 }
 
 TEST_CASE("the writer refuses quaternion nodes that break section 4.7") {

@@ -43,7 +43,7 @@ const char* const kArrayNames[L::kArrays] = {
 
 }  // namespace
 
-// The checks, in section 9.2's order. `where(a, i)` names entry i of array a. `skeleton`: SKEL's
+// The checks, in section 9.2's order (`entry` names an array's entry i, `where` gives its byte offset). `skeleton`: SKEL's
 // (parsed, or a cached rig's), which the quaternion nodes are checked against.
 Status Loader::check_image(const Content& c, const ClipSource& parts, const Skeleton& skeleton) {
   const uint64_t frames = parts.frame_count, channels = channel_count_;

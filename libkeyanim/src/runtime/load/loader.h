@@ -105,8 +105,9 @@ class Loader {
   // (internal::kMaxZstdExpansion), after the raw-size limit and before the checksum: a small
   // file declaring a large section is refused from the table (zstd_error, as inflating it would be).
   Status check_expansion();
-  // `critical` (0..4, CLIP..KVAL; -1 for NOTE) bounds a compressed section's Raw_Size by
-  // check_declared_size once its zstd frame header is checked, before it is inflated.
+  // `critical` (0..5: CLIP..KVAL, then QUAT at kQuatSlot; -1 for NOTE) bounds a compressed
+  // section's Raw_Size by check_declared_size once its zstd frame header is checked, before it
+  // is inflated.
   Status get_content(const TableEntry& e, const char* name, Content& out, int critical = -1,
                      const ClipSource* parts = nullptr);
   // Before a compressed critical section is inflated (get_content): its Raw_Size against what the sections
