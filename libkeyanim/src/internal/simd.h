@@ -134,4 +134,9 @@ inline void transpose(T& a, T& b, T& c, T& d) {
 }
 #endif
 
+// The integer vector of a float vector's lanes (F4: I4; simd8.h adds F8: I8), for code
+// written once for both widths.
+template <class V> struct IntLanes;
+template <> struct IntLanes<F4> { using type = I4; };
+
 }  // namespace keyanim::internal

@@ -72,6 +72,7 @@ KEYANIM_INLINE inline F8 select(F8 mask, F8 a, F8 b) {
 // Each half as F4's (one correctly rounded square root per lane).
 KEYANIM_INLINE inline F8 sqrt_lanes(F8 a) { return F8::join(sqrt_lanes(a.low()), sqrt_lanes(a.high())); }
 KEYANIM_INLINE inline F8 max0(F8 a) { return select(lane_mask(a.v > V8f{}), a, F8(0.0f)); }  // a > 0 ? a : 0
+template <> struct IntLanes<F8> { using type = I8; };
 
 }  // namespace keyanim::internal
 #else

@@ -62,11 +62,6 @@ KEYANIM_INLINE inline void load_rows(const float (*rows)[4], uint32_t i, F8 (&r)
   for (int k = 0; k < 4; ++k) r[k] = F8::join(lo[k], hi[k]);
 }
 #endif
-template <class V> struct IntOf;
-template <> struct IntOf<F4> { using type = I4; };
-#if KEYANIM_WIDE_LANES
-template <> struct IntOf<F8> { using type = I8; };
-#endif
 
 // The lanes of one V from lane i of a group starting at track t0: Appendix A for x, y, z (the
 // operations of sampler.cpp's evaluate_lanes, with u and the tangent scales computed once for
@@ -74,7 +69,7 @@ template <> struct IntOf<F8> { using type = I8; };
 template <class V, bool kAdjusted>
 KEYANIM_INLINE inline void track_lanes(const Image& img, const TrackBatch& b, const TrackFacts& x, const V& f,
                                        const V& rel, uint32_t t0, uint32_t i, uint32_t lanes, Transform* out) noexcept {
-  typename IntOf<V>::type k[4];
+  typename IntLanes<V>::type k[4];
   load_rows(b.frames, i, k);
   const V k0 = to_float(k[1]), k1 = to_float(k[2]), len = to_float(k[2] - k[1]);
   const V a0 = kAdjusted ? tangent_scale(len, to_float(k[1] - k[0])) : V(1.0f);

@@ -118,11 +118,6 @@ KEYANIM_INLINE inline void load_keys(const Batch& b, uint32_t i, I8 (&k)[4], F8 
   for (int r = 0; r < 4; ++r) k[r] = I8::join(klo[r], khi[r]), p[r] = F8::join(plo[r], phi[r]);
 }
 #endif
-template <class V> struct IntLanes;
-template <> struct IntLanes<F4> { using type = I4; };
-#if KEYANIM_WIDE_LANES
-template <> struct IntLanes<F8> { using type = I8; };
-#endif
 
 // Appendix A for the lanes of one V (F4: 4, F8: 8) from batch lane lane0 + i, whose facts are
 // x's from index i.
