@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "keyanim/offline/encode.h"
+#include "offline/encode/rotations.h"
 #include "offline/encode/signals.h"
 
 using namespace keyanim;
@@ -100,6 +101,28 @@ TEST_SUITE("signals") {
         }
       }
     }
+  }
+
+  TEST_CASE("a quaternion node's signals are the same held or read again, w included") {
+    // One node turning about all three axes; its w rebuilt from x, y, z and quat_signals' own
+    // w differ in the last bit at some frames, which changed a clip's bytes when its signals
+    // outgrew the budget.
+    Motion m;
+    m.skeleton.joints = {{"Root", -1, {0, 0, 0}, {ChannelType::z_rotation, ChannelType::x_rotation, ChannelType::y_rotation}},
+                         {"", 0, {0, 2, 0}, {}, true}};
+    m.skeleton.assign_channel_columns();
+    m.frame_count = 500;
+    m.frame_time = 0.1;
+    for (uint32_t f = 0; f < m.frame_count; ++f)
+      for (double a : {40.0 * std::sin(0.05 * f), 30.0 * std::cos(0.031 * f), 0.137 * f - 20.0}) m.values.push_back(a);
+    const ChannelLayout layout = channel_layout(m.skeleton, {QuatNode{0, {0, 0, 0}}});
+    std::array<std::vector<double>, 4> held, again;
+    Signals(m, layout, size_t(1) << 20, 1).get_quat(m, layout, 0, held);
+    Signals(m, layout, 0, 1).get_quat(m, layout, 0, again);
+    for (size_t k = 0; k < 4; ++k) CHECK(held[k] == again[k]);
+    std::array<std::vector<double>, 4> own;  // the node's rotation itself, w within rounding
+    quat_signals(m, layout.quats[0], own);
+    for (uint32_t f = 0; f < m.frame_count; ++f) CHECK(again[3][f] == doctest::Approx(own[3][f]).epsilon(1e-12));
   }
 
   TEST_CASE("unwrapping takes the shorter way at exactly 180 degrees as round() does") {

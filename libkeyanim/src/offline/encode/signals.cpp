@@ -157,11 +157,16 @@ void Signals::get(const Motion& m, const ChannelLayout& layout, uint32_t c, std:
 
 void Signals::get_quat(const Motion& m, const ChannelLayout& layout, uint32_t quat,
                        std::array<std::vector<double>, 4>& out) const {
-  if (values_.empty()) return quat_signals(m, layout.quats[quat], out);
-  const uint32_t c = internal::first_quat_channel(m.skeleton, layout.quats[quat].node);
-  for (uint32_t k = 0; k < 3; ++k) get(m, layout, c + k, out[k]);
-  out[3].resize(frames_);
-  for (uint32_t f = 0; f < frames_; ++f) {
+  if (values_.empty()) {
+    quat_signals(m, layout.quats[quat], out);
+  } else {
+    const uint32_t c = internal::first_quat_channel(m.skeleton, layout.quats[quat].node);
+    for (uint32_t k = 0; k < 3; ++k) get(m, layout, c + k, out[k]);
+  }
+  // w rebuilt from x, y, z either way (not quat_signals' own w, which can differ in its last
+  // bit): a clip's bytes must not depend on whether its signals fit the budget.
+  out[3].resize(out[0].size());
+  for (size_t f = 0; f < out[0].size(); ++f) {
     const double x = out[0][f], y = out[1][f], z = out[2][f];
     out[3][f] = std::sqrt(std::max(0.0, 1.0 - (x * x + y * y + z * z)));
   }
