@@ -1068,3 +1068,34 @@ def test_keyanim_convert_refuses_the_broken_version_5_content_too(case, tmp_path
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+# ---- 4.7's bound on a quaternion node's stored values (a content rule of the runtime profile)
+
+@pytest.mark.parametrize("bound", [16.0, 16.5])
+def test_a_stored_quaternion_value_beyond_16_is_refused(bound, tmp_path):
+    """v5_blocks_runtime's curve 0 (its quaternion track's x) with its Step scaled so that its
+    largest key is `bound`, its end values made to match: 16 decodes, 16.5 is refused by the
+    content checks (and by keyanim's converter, which checks content), not by the structure's."""
+    data = vector("v5_blocks_runtime.kanim")
+    image = image_of(data)[1]
+    assert len(image["tracks"][0]) == 3  # track 0: a quaternion track's x, y, z (curves 0, QT, 2QT)
+    frames, qs, values = image["keys"][0]
+    assert max(abs(v) for v in values) <= 1
+    top = max(abs(q) for q in qs)
+    step = bound / top
+    r = Runtime(data)
+    r.put("d", r.entry("Curves", 0, 24) + 8, step)
+    r.put("f", r.entry("First_Value", 0, 4), rd.f32(qs[0] * step))
+    r.put("f", r.entry("Last_Value", 0, 4), rd.f32(qs[-1] * step))
+    broken = r.bytes()
+    clip = rd.parse(broken, check_content=False)
+    x = image["arrays"]["Curve_Channel"][0]
+    assert max(abs(v) for v in clip["values"][x]) == bound
+    if bound <= 16:
+        rd.parse(broken, check_content=True)
+        return
+    with pytest.raises(rd.KanimError) as e:
+        rd.parse(broken, check_content=True)
+    assert e.value.status == "corrupt" and "16" in str(e.value)
+    cli_refuses(broken, "corrupt", tmp_path)

@@ -319,6 +319,14 @@ def hamilton(a, b):
             aw * bw - ax * bx - ay * by - az * bz)
 
 
+def check_stored_bound(values, quats):
+    """4.7: every key of a quaternion node's stored x, y, z within +-16 (values: per channel)."""
+    for quat in quats:
+        for c in range(quat["column"], quat["column"] + 3):
+            if any(abs(v) > 16 for v in values[c]):
+                raise KanimError("corrupt", f"channel {c}: a quaternion node's stored value beyond +-16")
+
+
 def quat_rotation(reference, sx, sy, sz):
     """4.7: the rotation (x, y, z, w) of a quaternion node with this reference (X, Y, Z) and
     stored values sx, sy, sz (binary32), in binary64: r (s, w) normalized. The stored values
@@ -533,6 +541,7 @@ def decode_archive(content, major, minor, file_size):
         quantized.append(qs)
     if layout < 3 and not all(p.at_end() for p in planes):
         raise KanimError("corrupt", "KVAL plane bytes left over")
+    check_stored_bound(values, quats)
 
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,
             "nodes": nodes, "interp": interp, "tension": tension, "frames": frames, "values": values,
@@ -665,6 +674,7 @@ def decode_runtime(content, major, minor, check_content=True):
     image = parse_image(content["IMAG"], F, C, K, major, nodes)
     if check_content:
         check_image_content(image)
+        check_stored_bound(image["values"], image["quat_nodes"])
     if nodes is None:
         nodes = parse_skel(content["SKEL"], N, C)
     return {"version": (major, minor), "frame_count": F, "frame_time": frame_time, "tangent_rule": rule,

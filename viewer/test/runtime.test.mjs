@@ -281,6 +281,31 @@ for (const [name, c] of Object.entries(cases)) {
   });
 }
 
+// 4.7's bound (a content rule of 9.4, which this decoder checks): v5_blocks_runtime's curve 0,
+// its quaternion track's x, with its Step scaled so that its largest key is 16 (decodes) or 16.5
+// (refused), its First_Value and Last_Value made to match the scaled keys.
+test('v5: a quaternion node\'s stored value beyond ±16 is refused, 16 is not', () => {
+  const x = dv(v5b).getUint32(el(a5b, 'Curve_Channel', 0), true);
+  const keys = decodeKanim(v5b).channels[x].values;
+  const step = dv(v5b).getFloat64(el(a5b, 'Curves', 0, 24) + 8, true);
+  const qs = Array.from(keys, (v) => Math.round(v / step));
+  const top = Math.max(...qs.map(Math.abs));
+  assert.ok(top > 0 && Math.max(...Array.from(keys, Math.abs)) <= 1);
+  const scaled = (bound) => patch5b((b, v) => {
+    const s = bound / top;
+    v.setFloat64(el(a5b, 'Curves', 0, 24) + 8, s, true);
+    v.setFloat32(el(a5b, 'First_Value', 0), Math.fround(qs[0] * s), true);
+    v.setFloat32(el(a5b, 'Last_Value', 0), Math.fround(qs[qs.length - 1] * s), true);
+  });
+  const ok = decodeKanim(scaled(16)).channels[x].values;
+  assert.equal(Math.max(...Array.from(ok, Math.abs)), 16);
+  assert.throws(() => decodeKanim(scaled(16.5)), (e) => {
+    assert.equal(e.status, 'corrupt', e.message);
+    assert.ok(e.message.includes(`channel ${x}`) && e.message.includes('±16'), e.message);
+    return true;
+  });
+});
+
 test('a 4.0 file with Runtime clear is an archive file (v3_rules as 4.0)', () => {
   const got = decodeKanim(withCrc32(read('v3_rules.kanim'), (b) => { b[8] = 4; }));
   const want = decodeKanim(read('v3_rules.kanim'));

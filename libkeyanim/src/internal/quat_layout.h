@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "internal/clip_source.h"
 #include "internal/format.h"
 #include "keyanim/rotation.h"
 #include "keyanim/skeleton.h"
@@ -58,6 +59,26 @@ inline bool reference_from_floats(const float (&q)[4], QuatNode& n) noexcept {
   float back[4];
   reference_of(n, back);
   return std::memcmp(back, q, sizeof back) == 0;
+}
+
+// Section 4.7's bound on a quaternion node's stored x, y, z: every key's value within +-16. A
+// rotation's components are within +-1 (the encoder's keys within +-2); the bound keeps every
+// in-between's square sum far from binary32's overflow (about 1.8e19 squared), where a binary32
+// pose and a binary64 one would disagree (a zero or NaN rotation against a finite one).
+inline constexpr double kMaxStoredQuatValue = 16.0;
+
+// The first channel of `src` (keys decoded) holding a quaternion node's stored x, y or z with a
+// key beyond kMaxStoredQuatValue, or UINT32_MAX when none has.
+inline uint32_t stored_quat_out_of_range(const ClipSource& src) {
+  if (src.quat_nodes.empty()) return UINT32_MAX;
+  const std::vector<Stored> kinds = stored_kinds(src.skeleton, src.quat_nodes);
+  for (uint32_t c = 0; c < src.channels.size(); ++c) {
+    if (kinds[c] == Stored::value) continue;
+    const SourceChannel& sc = src.channels[c];
+    for (uint64_t i = sc.first_key; i < sc.first_key + sc.key_count; ++i)
+      if (!(std::fabs(dequantize(src.q[i], sc.step)) <= kMaxStoredQuatValue)) return c;
+  }
+  return UINT32_MAX;
 }
 
 }  // namespace keyanim::internal

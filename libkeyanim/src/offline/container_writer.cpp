@@ -229,6 +229,12 @@ std::string quat_problem(const EncodedClip& clip) {
       if (o.interp != x.interp || std::memcmp(&o.tension, &x.tension, sizeof(float)) != 0 || o.frames != x.frames)
         return where + "its x, y and z differ in interpolation, tension or key frames";
     }
+    for (uint32_t k = 0; k < 3; ++k) {
+      const EncodedChannel& ch = clip.channels[c + k];
+      for (int64_t q : ch.q)
+        if (!(std::fabs(dequantize(q, ch.step)) <= internal::kMaxStoredQuatValue))
+          return where + "a key of its stored x, y or z beyond +-16";
+    }
   }
   return {};
 }

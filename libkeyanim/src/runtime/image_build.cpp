@@ -485,6 +485,7 @@ bool image_content_holds(const Image& img) {
     for (uint64_t i = sc.first_key; i < sc.first_key + sc.key_count; ++i)
       if (keys.q[i] > kMaxAbsQ || keys.q[i] < -kMaxAbsQ || !std::isfinite(dequantize(keys.q[i], sc.step))) return false;
   }
+  if (stored_quat_out_of_range(keys) != UINT32_MAX) return false;
   Image rebuilt;
   write_imag(build_arrays(keys), rebuilt);
   return rebuilt.imag.size() == img.imag.size() && std::memcmp(rebuilt.imag.data(), img.imag.data(), img.imag.size()) == 0;

@@ -12,6 +12,7 @@
 #include "clips.h"
 #include "crafted.h"
 #include "keyanim/offline/fk.h"
+#include "internal/quat_layout.h"
 #include "keyanim/rotation.h"
 #include "runtime/image.h"
 
@@ -225,6 +226,44 @@ TEST_CASE("the writer refuses quaternion nodes that break section 4.7") {
   e = good;
   e.channels[c + 2].interp = e.channels[c].interp == kLin ? kCard : kLin;
   refused(e, "z's interpolation differs");
+  e = good;
+  for (int64_t& q : e.channels[c + 1].q) q = q == 0 ? 0 : q > 0 ? 17 : -17;
+  e.channels[c + 1].step = 1.0;
+  REQUIRE(std::any_of(e.channels[c + 1].q.begin(), e.channels[c + 1].q.end(), [](int64_t q) { return q != 0; }));
+  refused(e, "a stored y beyond +-16");
+}
+
+TEST_CASE("the loader refuses a quaternion node's stored value beyond +-16 (section 4.7), and takes 16") {
+  // The file crafted past the writer (which refuses it, above): an uncompressed file whose x
+  // channel of a quaternion node has its Step scaled so that its largest key is 16, then 16.5.
+  const EncodedClip e = random_quat_clip(9, 100, 4);
+  const uint32_t c = e.skeleton.joints[1].first_channel;
+  REQUIRE(keyanim::internal::stored_kinds(e.skeleton, e.quat_nodes)[c] == keyanim::internal::Stored::quat_x);
+  int64_t top = 0;
+  for (int64_t q : e.channels[c].q) top = std::max<int64_t>(top, q < 0 ? -q : q);
+  REQUIRE(top > 0);
+  const RawFile base = split(keyanim::offline::write_kanim(e, 0));
+  const size_t channels = e.channels.size();
+  for (const double bound : {16.0, 16.5}) {
+    CAPTURE(bound);
+    RawFile r = base;
+    RawSection& chan = r.get("CHAN");
+    REQUIRE(chan.flags == 0);
+    poke(chan.stored, 5 * channels + 8 * c, bound / double(top));  // Step of channel c (4.3)
+    const Loaded l = load(r.build());
+    if (bound <= 16.0) {
+      REQUIRE(l.status == Status::ok);
+      const auto keys = keyanim::test::channel_keys(l.clip, c);
+      float most = 0.0f;
+      for (float v : keys.values) most = std::max(most, std::fabs(v));
+      CHECK(most == 16.0f);
+    } else {
+      CHECK(l.status == Status::corrupt);
+      CHECK(l.err.section == "KVAL");
+      CHECK(l.err.detail.find("channel " + std::to_string(c)) != std::string::npos);
+      CHECK(l.err.detail.find("16") != std::string::npos);
+    }
+  }
 }
 
 }  // TEST_SUITE

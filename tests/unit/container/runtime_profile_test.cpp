@@ -631,6 +631,47 @@ TEST_CASE("runtime profile: a Step whose values overflow binary32 is a content b
   }
 }
 
+TEST_CASE("runtime profile: a quaternion node's stored value beyond +-16 is a content break (section 4.7)") {
+  // v5_blocks_runtime's curve 0 is its quaternion track's x (curves [0, 3 QT) are the tracks').
+  // Its Step scaled so that its largest key is exactly 16 (allowed), then 16.5 (refused by
+  // check_content; the structure checks pass and sampling stays harmless).
+  const std::vector<uint8_t> good = read_file(vector_path("v5_blocks_runtime", ".kanim"));
+  const RuntimeFile f(good);
+  REQUIRE(get_le(good, f.imag + 28, 4) >= 1);  // Quat_Track_Count
+  const Loaded original = load(good, true);
+  REQUIRE(original.status == Status::ok);
+  const uint32_t ch = uint32_t(get_le(good, f.at[RuntimeFile::curve_channel], 4));
+  REQUIRE(original.clip.channel(ch).stored == keyanim::StoredAs::quat_x);
+  const auto keys = keyanim::test::channel_keys(original.clip, ch);
+  const double step = std::bit_cast<double>(get_le(good, f.at[RuntimeFile::curves] + 8, 8));
+  float largest = 0.0f;
+  for (float v : keys.values) largest = std::max(largest, std::fabs(v));
+  REQUIRE(largest > 0.0f);
+  REQUIRE(largest <= 1.0f);
+  const double top = std::round(largest / step);  // the largest |q|
+  for (const double bound : {16.0, 16.5}) {
+    CAPTURE(bound);
+    std::vector<uint8_t> b = good;
+    put_le(b, f.at[RuntimeFile::curves] + 8, 8, std::bit_cast<uint64_t>(bound / top));
+    fix_xxh64(b);
+    const Loaded l = load(b);
+    REQUIRE(l.status == Status::ok);
+    const auto got = keyanim::test::channel_keys(l.clip, ch);
+    // The curve's end values as its keys now give them (9.2), so that the bound is the only
+    // content rule the file can break.
+    put_le(b, f.at[RuntimeFile::first_value], 4, std::bit_cast<uint32_t>(got.values.front()));
+    put_le(b, f.at[RuntimeFile::last_value], 4, std::bit_cast<uint32_t>(got.values.back()));
+    fix_xxh64(b);
+    const Loaded c = load(b, true);
+    float most = 0.0f;
+    for (float v : got.values) most = std::max(most, std::fabs(v));
+    CHECK(most == float(bound));
+    CHECK(c.status == (bound <= 16.0 ? Status::ok : Status::corrupt));
+    std::vector<Transform> pose(l.clip.skeleton().joints.size());
+    for (double x = 0.0; x < l.clip.frame_count(); x += 7.5) CHECK(l.clip.sample_model(x, pose) == Status::ok);
+  }
+}
+
 TEST_CASE("runtime profile: lifetime of a clip's bytes (clip.h)") {
   const std::vector<uint8_t> good = v4_rules();
   const Loaded reference = load(good);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "internal/byte_reader.h"
+#include "internal/quat_layout.h"
 #include "internal/format.h"
 #include "internal/value_coding.h"
 #include "internal/varint.h"
@@ -188,6 +189,9 @@ Status Loader::parse_kval_fixed(const Content& c, ClipSource& parts) {
       return fail_in(Status::corrupt, c, bytes ? plane[0] - c.data : 0,
                      "channel " + std::to_string(ch) + ": a key value is not finite");
   }
+  if (const uint32_t ch = internal::stored_quat_out_of_range(parts); ch != UINT32_MAX)
+    return fail_in(Status::corrupt, c, 0,
+                   "channel " + std::to_string(ch) + ": a quaternion node's stored x, y or z has a key beyond +-16 (section 4.7)");
   return Status::ok;
 }
 

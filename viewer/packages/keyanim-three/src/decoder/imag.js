@@ -8,7 +8,7 @@
 import { imageLayout, IMAG_HEADER_BYTES } from './imag-layout.js';
 import { recordKeys } from './imag-records.js';
 import { checkContent } from './imag-content.js';
-import { quatNodeProblem, quatColumn, addQuatNode, MAX_REFERENCE_NORM2 } from './quat-nodes.js';
+import { quatNodeProblem, quatColumn, addQuatNode, checkStoredBound, MAX_REFERENCE_NORM2 } from './quat-nodes.js';
 
 const NONE = 0xffffffff, TWO53 = 2n ** 53n, INF_BITS = 0x7f800000;
 const BLOCK_SHIFT = 6;  // blocks of 64 frames
@@ -34,6 +34,7 @@ export function decodeImage(r, clip) {
   for (const cv of curves) Object.assign(channels[cv.channel], { step: cv.step, keyFrames: cv.frames, values: cv.values });
   for (const q of clip.quatNodes) channels[q.column + 1].keyFrames = channels[q.column + 2].keyFrames = channels[q.column].keyFrames;
   clip.channels = channels;
+  checkStoredBound(r, clip, 0);
 }
 
 function readHeader(r, clip) {

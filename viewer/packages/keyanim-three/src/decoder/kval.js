@@ -2,6 +2,8 @@
 // quantized values q -> key values v = RN32(q x Step). q can reach 2^53 and residuals 2^57,
 // so they are BigInts.
 
+import { checkStoredBound } from './quat-nodes.js';
+
 const TWO53 = 2n ** 53n, TWO57 = 2n ** 57n, TWO54 = 2n ** 54n, TWO40 = 2n ** 40n;
 const abs = (x) => (x < 0n ? -x : x);
 const unzigzag = (u) => (u & 1n ? -((u + 1n) >> 1n) : u >> 1n);
@@ -31,6 +33,7 @@ export function decodeKeyValues(r, clip) {
     }
     ch.values = values;
   });
+  checkStoredBound(r, clip, 0);
 }
 
 // pred_i of section 4.5 (Value_Coding 0 for every channel of a 1.0 file).

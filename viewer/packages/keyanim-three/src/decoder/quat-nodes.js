@@ -53,3 +53,16 @@ export function parseQuat(r, clip) {
     previous = n;
   }
 }
+
+// 4.7: every key of a quaternion node's stored x, y, z within ±16 (a content rule of the runtime
+// profile, 9.4), once the channels' values are known; `at`: where a failure is reported.
+export function checkStoredBound(r, clip, at) {
+  for (const q of clip.quatNodes) {
+    for (let k = 0; k < 3; ++k) {
+      const c = q.column + k;
+      for (const v of clip.channels[c].values) {
+        if (!(Math.abs(v) <= 16)) r.fail('corrupt', at, `channel ${c}: a key value ${v} of quaternion node ${q.node}'s stored ${'xyz'[k]} is beyond ±16 (4.7)`);
+      }
+    }
+  }
+}
