@@ -261,8 +261,8 @@ Status Clip::sample_local(double frame_position, std::span<Transform> out, Curso
   if (cursor != nullptr) {
     if (!cursor->prepared_for(*this)) return Status::invalid_argument;
     float* values = cursor->state_->channels.data();
-    internal::sample_playback(img, *cursor->state_, f, values);
-    internal::local_transforms(img, 0, nodes, values, reading, out.data());
+    internal::sample_playback(img, *cursor->state_, f, values, out.data());  // the tracks' rotations too
+    internal::local_transforms(img, 0, nodes, values, reading, out.data(), true);
     return Status::ok;
   }
   // Without a cursor, the whole pose in a stack buffer when it fits (the usual skeleton), else

@@ -4,6 +4,7 @@
 // Cursor compiled for each CPU level (internal/cpu.h) never call code of another level.
 #pragma once
 #include <cstdint>
+#include <cstring>
 
 #include "internal/cpu.h"
 #include "runtime/gather.h"
@@ -54,6 +55,16 @@ KEYANIM_INLINE inline bool advance_stream(KeyStream& s) noexcept {
   s.k[0] = s.k[1], s.k[1] = s.k[2], s.k[2] = s.k[3], s.k[3] = next;
   s.v[0] = s.v[1], s.v[1] = s.v[2], s.v[2] = s.v[3], s.v[3] = value;
   return true;
+}
+
+// Moves stream s (a quaternion track's y or z) one key forward with x, its track's x, which has
+// just moved (advance_stream true): the same key frames (one Mask for the three), so only s's
+// next value is read, from its own value run, in the order advance_stream would read it.
+KEYANIM_INLINE inline void follow_stream(KeyStream& s, const KeyStream& x) noexcept {
+  const float value = dequantize(s.low + static_cast<int64_t>(read_bits(s.rec, s.next_at, s.value_bits)), s.step);
+  s.next_at += s.value_bits;
+  std::memcpy(s.k, x.k, sizeof s.k);
+  s.v[0] = s.v[1], s.v[1] = s.v[2], s.v[2] = s.v[3], s.v[3] = value;
 }
 
 namespace {

@@ -176,6 +176,93 @@ TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its
   CHECK(worst_angles > 0.0);
 }
 
+// A Cursor moves a quaternion track's three streams together and gives its three states one
+// range (cursor.cpp); sample_local with a cursor builds the tracks' rotations from the curves'
+// values, not from the channels. Each must give the plain sampler's bits: forward steps,
+// backward sweeps, far jumps (inside, before and after the keys), a cursor shared by every
+// method, on clips with and without an Euler root.
+TEST_CASE("a cursor plays quaternion tracks as the plain sampler does, bit for bit") {
+  for (const EncodedClip& e : {random_quat_clip(11, 700, 12), random_quat_clip(12, 900, 13, true)}) {
+    const Clip clip = keyanim::offline::to_clip(e);
+    const uint32_t n = clip.channel_count(), nodes = uint32_t(clip.skeleton().joints.size());
+    std::vector<float> a(n), b(n);
+    std::vector<Transform> p(nodes), q(nodes);
+    keyanim::Cursor cursor;
+    REQUIRE(cursor.prepare(clip) == Status::ok);
+    uint64_t s = 17, mismatches = 0;
+    const double F = e.frame_count;
+    for (int i = 0; i < 3000; ++i) {
+      const double x = i < 1000 ? i * 0.73 - 2.0 : i < 2000 ? F + 1.0 - (i - 1000) * 0.61 : double(lcg(s) % 100000) / 100000.0 * (F + 20.0) - 10.0;
+      switch (i % 4) {
+        case 0:
+          REQUIRE(clip.sample(x, a) == Status::ok);
+          REQUIRE(clip.sample(x, b, &cursor) == Status::ok);
+          break;
+        case 1:
+          REQUIRE(clip.sample_stored(x, a) == Status::ok);
+          REQUIRE(clip.sample_stored(x, b, &cursor) == Status::ok);
+          break;
+        case 2:
+          REQUIRE(clip.sample_local(x, p) == Status::ok);
+          REQUIRE(clip.sample_local(x, q, &cursor) == Status::ok);
+          break;
+        default:
+          REQUIRE(clip.sample_model(x, p) == Status::ok);
+          REQUIRE(clip.sample_model(x, q, &cursor) == Status::ok);
+      }
+      for (uint32_t c = 0; c < n; ++c) mismatches += !same_bits(a[c], b[c]);
+      mismatches += std::memcmp(p.data(), q.data(), nodes * sizeof(Transform)) != 0;
+    }
+    CHECK(mismatches == 0);
+  }
+}
+
+// A track whose y keys are +0, -0, +0, -0 (q of both signs times a step that rounds them to
+// zero): at those key frames the polynomial would give +0 for -0, so the cursor must make the
+// track's key frame a direct state for its three curves, not for y alone: their states share
+// one range, checked on x's lanes only (a y of its own range would keep its key's value past
+// the key frame), and x and z still give their own values there.
+TEST_CASE("a cursor gives a quaternion track's key values at its key frames when its y's is -0") {
+  EncodedClip e;
+  e.skeleton.joints.push_back(node("root", -1, 0, 0, 0, {CT::z_rotation, CT::x_rotation, CT::y_rotation}));
+  e.skeleton.joints.push_back(node("end", 0, 0, 1, 0, {}, true));
+  e.frame_count = 40;
+  e.frame_time = 1.0 / 30.0;
+  e.tangent_rule = TangentRule::step_adjusted;
+  e.quat_nodes = {QuatNode{0, {0, 0, 0}}};
+  const int64_t q[3][4] = {{3, -3, 3, -3}, {1, -1, 2, -3}, {1, 2, 3, 4}};
+  const double step[3] = {0.1, 1e-300, 0.05};
+  for (int c = 0; c < 3; ++c) {
+    EncodedChannel ch;
+    ch.interp = kCard;
+    ch.tension = 0.0f;
+    ch.step = step[c];
+    ch.frames = {0, 10, 25, 39};
+    ch.q.assign(q[c], q[c] + 4);
+    e.channels.push_back(std::move(ch));
+  }
+  const Clip clip = keyanim::offline::to_clip(e);
+  std::vector<float> a(3), b(3);
+  std::vector<Transform> p(2), r(2);
+  keyanim::Cursor cursor;
+  REQUIRE(cursor.prepare(clip) == Status::ok);
+  uint64_t mismatches = 0, minus_zero = 0;
+  for (double x = 0.0; x <= 39.0; x += 0.5) {
+    REQUIRE(clip.sample_stored(x, a) == Status::ok);
+    REQUIRE(clip.sample_stored(x, b, &cursor) == Status::ok);
+    for (int c = 0; c < 3; ++c) mismatches += !same_bits(a[c], b[c]);
+    minus_zero += (x == 10.0 || x == 39.0) && same_bits(b[1], -0.0f);
+    REQUIRE(clip.sample_local(x, p) == Status::ok);
+    REQUIRE(clip.sample_local(x, r, &cursor) == Status::ok);
+    mismatches += std::memcmp(p.data(), r.data(), sizeof(Transform)) != 0;
+  }
+  CHECK(mismatches == 0);
+  CHECK(minus_zero == 2);  // the test reaches the case
+  REQUIRE(clip.sample_stored(25.0, b, &cursor) == Status::ok);
+  CHECK(b[0] == 0.3f);
+  CHECK(b[2] == 0.15f);
+}
+
 TEST_CASE("quat_in_node_order is the merge of the tracks' and the others' node lists") {
   // Every split of node sets drawn from 0..11 into tracks and others, each group increasing:
   // the binary search against the two lists merged by hand.
