@@ -65,12 +65,19 @@ constexpr uint32_t kRefreshBatch = 32;
 // tracks, three curves each, and padding lanes to a multiple of 4.
 constexpr uint32_t kRefreshCurves = 3 * (kRefreshBatch + 3) + 3;
 
+// The state's arrays, as plain pointers: held in registers through a refresh (a vector's data
+// pointer is read again after every store through a uint8_t).
+struct Play {
+  SegmentLanes* lanes;
+  KeyStream* streams;
+};
+
 // Curve i's state: its group of lanes and its lane there.
 struct Slot {
   SegmentLanes& g;
   uint32_t l;
 };
-KEYANIM_INLINE inline Slot slot(Cursor::State& st, uint32_t i) noexcept { return {st.lanes[i >> 3], i & 7}; }
+KEYANIM_INLINE inline Slot slot(Play st, uint32_t i) noexcept { return {st.lanes[i >> 3], i & 7}; }
 
 // A state where curve i's value is `value` for lo <= f < hi.
 KEYANIM_INLINE inline void set_direct(Slot s, float value, float lo, float hi) noexcept {
@@ -83,7 +90,7 @@ KEYANIM_INLINE inline void set_direct(Slot s, float value, float lo, float hi) n
 
 // Curves c[0 .. n) (one curve, or a quaternion track's three, whose key frames are the same)
 // clamped at f outside their keys: true (their states set), else false.
-KEYANIM_INLINE inline bool clamped(const Image& img, Cursor::State& st, const uint32_t* c, uint32_t n, float f) noexcept {
+KEYANIM_INLINE inline bool clamped(const Image& img, Play st, const uint32_t* c, uint32_t n, float f) noexcept {
   const float first = img.first_frame[c[0]], last = img.last_frame[c[0]];
   if (!(f > first)) {
     for (uint32_t k = 0; k < n; ++k) set_direct(slot(st, c[k]), img.first_value[c[k]], -kInf, next_above(first));
@@ -110,7 +117,7 @@ KEYANIM_INLINE inline bool forward(KeyStream& ks, float f, KeyStream* const* fol
 // Step one of a refresh for curve i alone: false (and the state set) when f is outside its
 // keys, where it is clamped; else its stream is on f's segment (forward, or a seek), and the
 // operands are left to the batch (step two).
-KEYANIM_INLINE inline bool position_curve(const Image& img, Cursor::State& st, uint32_t i, float f) noexcept {
+KEYANIM_INLINE inline bool position_curve(const Image& img, Play st, uint32_t i, float f) noexcept {
   if (clamped(img, st, &i, 1, f)) return false;
   if (!forward(st.streams[i], f, nullptr, 0)) seek_stream(img, i, f, st.streams[i]);
   return true;
@@ -118,7 +125,7 @@ KEYANIM_INLINE inline bool position_curve(const Image& img, Cursor::State& st, u
 
 // The same for quaternion track t, curves c = {t, T + t, 2T + t}: one range check and one walk
 // of the key frames for the three (their streams were positioned together, and stay so).
-KEYANIM_INLINE inline bool position_track(const Image& img, Cursor::State& st, const uint32_t (&c)[3], float f) noexcept {
+KEYANIM_INLINE inline bool position_track(const Image& img, Play st, const uint32_t (&c)[3], float f) noexcept {
   if (clamped(img, st, c, 3, f)) return false;
   KeyStream* const follow[2] = {&st.streams[c[1]], &st.streams[c[2]]};
   if (!forward(st.streams[c[0]], f, follow, 2))
@@ -141,7 +148,7 @@ struct Segments {
 // equals the sampler's (both round f - K_j once); lengths are rounded once from the integer
 // differences. At f == K_j the polynomial gives p0 + (+-0) ... = p0 exactly, as Appendix A's
 // v_j, when the operands are finite and p0 is not -0 (-0 + +0 is +0): `exact`.
-KEYANIM_INLINE inline void operands4(const Image& img, const Cursor::State& st, const uint32_t* curve, Segments& seg,
+KEYANIM_INLINE inline void operands4(const Image& img, Play st, const uint32_t* curve, Segments& seg,
                                      uint32_t j) noexcept {
   I4 k[4];
   F4 p[4];
@@ -165,13 +172,14 @@ KEYANIM_INLINE inline void operands4(const Image& img, const Cursor::State& st, 
   const uint32_t exact = finite & ~(sign_bits(cmp_eq(o.p0, zero)) & sign_bits(o.p0));
   k0.store(seg.k0 + j), k1.store(seg.k1 + j), o.p0.store(seg.p0 + j), o.d.store(seg.d + j);
   o.m0.store(seg.m0 + j), o.m1.store(seg.m1 + j);
-  for (uint32_t l = 0; l < 4; ++l) seg.exact[j + l] = static_cast<uint8_t>((exact >> l) & 1);
+  const uint32_t bytes = (exact * 0x00204081u) & 0x01010101u;  // bit l to byte l (l < 4)
+  std::memcpy(seg.exact + j, &bytes, sizeof bytes);
 }
 
 // Curve i's state from entry j of seg. `exact` for every curve sharing the state's range (a
 // track's three): the range [K_j, K_j+1) then; else K_j is a direct state of its own (f ==
 // K_j), or the range starts just above it.
-KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint32_t i, float f, const Segments& seg,
+KEYANIM_INLINE inline void set_segment(const Image& img, Play st, uint32_t i, float f, const Segments& seg,
                                        uint32_t j, bool exact) noexcept {
   const Slot at = slot(st, i);
   SegmentLanes& g = at.g;
@@ -192,7 +200,7 @@ KEYANIM_INLINE inline void set_segment(const Image& img, Cursor::State& st, uint
 // x, t < T): each one's stream first (a track's three together), then the operands of those
 // inside their keys four at a time, then their states (a track's three with one range: exact
 // only if all three are).
-KEYANIM_INLINE inline void refresh(const Image& img, Cursor::State& st, const uint32_t* stale, uint32_t count,
+KEYANIM_INLINE inline void refresh(const Image& img, Play st, const uint32_t* stale, uint32_t count,
                                    float f) noexcept {
   const uint32_t T = img.quat_tracks;
   uint32_t inside[kRefreshCurves];
@@ -233,7 +241,7 @@ KEYANIM_INLINE inline void evaluate_lanes(const SegmentLanes& g, const V& f, uin
 
 // Lanes [i, i + 4) of the curves whose range is checked, [first, end), with a bit for each
 // lane outside it: the curves there whose state f left.
-KEYANIM_INLINE inline uint32_t stale_lanes(const Cursor::State& st, const F4& f, uint32_t i, uint32_t first,
+KEYANIM_INLINE inline uint32_t stale_lanes(Play st, const F4& f, uint32_t i, uint32_t first,
                                            uint32_t end) noexcept {
   const SegmentLanes& g = st.lanes[i >> 3];
   uint32_t bits = outside(f, F4::load(g.lo + (i & 7)), F4::load(g.hi + (i & 7)));
@@ -244,7 +252,7 @@ KEYANIM_INLINE inline uint32_t stale_lanes(const Cursor::State& st, const F4& f,
 
 // Which curves left their segment, 4 lanes at a time, refreshed in batches: quaternion tracks
 // by their x (curves [0, T): their y's and z's share its range), then the curves [3T, n).
-KEYANIM_INLINE inline void refresh_stale(const Image& img, Cursor::State& st, float f) noexcept {
+KEYANIM_INLINE inline void refresh_stale(const Image& img, Play st, float f) noexcept {
   const uint32_t n = static_cast<uint32_t>(img.curves.size()), T = img.quat_tracks;
   const F4 fv(f);
   uint32_t stale[kRefreshBatch + 3];
@@ -281,7 +289,7 @@ KEYANIM_INLINE inline void track_rotations(const Image& img, const float* result
 template <bool kWide>
 KEYANIM_INLINE inline void playback_impl(const Image& img, Cursor::State& st, float f, float* out,
                                          Transform* tracks) noexcept {
-  refresh_stale(img, st, f);
+  refresh_stale(img, Play{st.lanes.data(), st.streams.data()}, f);
   // Every group's lanes, padding included (it holds direct states).
   float* result = st.results.data();
 #if KEYANIM_WIDE_LANES
