@@ -103,9 +103,10 @@ bool quat_of_channel(const Image& img, uint32_t c, uint32_t& quat, uint32_t& com
 void quat_euler(const Image& img, uint32_t i, const float (&xyz)[3], float (&out)[3]) noexcept {
   QuatNode n;
   n.node = img.quat_node[i];
-  float ref[4];
-  for (uint32_t k = 0; k < 4; ++k) ref[k] = img.quat_reference[k * img.quat_lanes + i];
-  internal::reference_from_floats(ref, n);  // the image's were checked so
+  // The image's reference floats are X x 2^-15 exactly (checked when it was made or loaded):
+  // times 2^15 they are the integers themselves, without reference_from_floats' checks.
+  for (uint32_t k = 0; k < 3; ++k)
+    n.reference[k] = static_cast<int16_t>(img.quat_reference[k * img.quat_lanes + i] * (1.0f / float(kReferenceUnit)));
   double q[4], deg[3];
   stored_rotation(n, xyz[0], xyz[1], xyz[2], q);
   const Joint& j = img.rig->skeleton.joints[img.quat_node[i]];

@@ -166,6 +166,12 @@ TEST_CASE("a quaternion node's pose is its reference times (x, y, z, w), and its
       const uint8_t axes[3] = {uint8_t(keyanim::channel_axis(j.channels[0])), uint8_t(keyanim::channel_axis(j.channels[1])),
                                uint8_t(keyanim::channel_axis(j.channels[2]))};
       const double deg[3] = {angles[c], angles[c + 1], angles[c + 2]};
+      // sample()'s angles are Appendix B's from the node's own reference (the clip's QUAT entry,
+      // not the image's binary32 copy of it), bit for bit.
+      double exact_q[4], exact_deg[3];
+      keyanim::stored_rotation(qn, stored[c], stored[c + 1], stored[c + 2], exact_q);
+      keyanim::euler_from_quaternion(exact_q, axes, exact_deg);
+      for (int k = 0; k < 3; ++k) CHECK(angles[c + k] == float(exact_deg[k]));
       double back[4];
       compose(axes, deg, back);
       worst_angles = std::max(worst_angles, angle_between(q, back));
