@@ -2,8 +2,11 @@
 // other rigs (another hierarchy, or one OFFSET bit apart) do not; sharing changes no sample.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -11,6 +14,7 @@
 #include "keyanim/offline/bvh.h"
 #include "keyanim/offline/container.h"
 #include "keyanim/offline/encode.h"
+#include "runtime/image.h"
 
 using namespace keyanim;
 using namespace keyanim::offline;
@@ -89,6 +93,52 @@ TEST_CASE("loading through one cache from several threads gives one rig") {
   for (auto& t : threads) t.join();
   CHECK(rigs.rig_count() == 1);
   for (const Clip& c : clips) CHECK(c.shares_rig(clips[0]));
+}
+
+
+// Version 5: the Euler groups of the nodes a clip does not store as quaternions are made once
+// per set of quaternion nodes and kept by the rig (Rig::plans): clips of one set share them, a
+// new set adds one, and past Rig::kMaxQuatPlans sets a clip makes its own. Every plan holds
+// exactly the rig's Euler nodes but the set's.
+TEST_CASE("a rig makes the Euler groups of each set of quaternion nodes once, up to its limit") {
+  Skeleton s;
+  const uint32_t joints = uint32_t(internal::Rig::kMaxQuatPlans) + 3;
+  for (uint32_t j = 0; j < joints; ++j)
+    s.joints.push_back({"j" + std::to_string(j), int32_t(j) - 1, {0, 1, 0},
+                        {ChannelType::z_rotation, ChannelType::x_rotation, ChannelType::y_rotation}});
+  s.assign_channel_columns();
+  const std::shared_ptr<const internal::Rig> rig = internal::make_rig(std::move(s));
+  // Image k stores node k as a quaternion node; images 0 and 1 make one set, so 0 .. joints - 2
+  // make joints - 2 sets: past the limit for the last ones.
+  std::vector<std::vector<uint32_t>> sets(joints - 1);
+  std::vector<std::unique_ptr<internal::Image>> images;
+  for (uint32_t k = 0; k + 1 < joints; ++k) {
+    sets[k] = k == 1 ? std::vector<uint32_t>{0} : std::vector<uint32_t>{k};
+    auto img = std::make_unique<internal::Image>();
+    img->rig = rig;
+    img->quat_node = sets[k];
+    internal::plan_rotations(*img);
+    const size_t distinct = k == 0 ? 1 : k;  // sets made so far, this one's included
+    if (distinct <= internal::Rig::kMaxQuatPlans) {
+      CHECK(img->euler == img->rig_euler.get());
+      CHECK(img->own_euler.node.empty());
+    } else {
+      CHECK(img->rig_euler == nullptr);
+      CHECK(img->euler == &img->own_euler);
+    }
+    std::vector<uint32_t> euler_nodes;  // the plan's nodes: every node but the set's
+    for (const auto& g : img->euler->groups)
+      euler_nodes.insert(euler_nodes.end(), img->euler->node.begin() + g.node_first, img->euler->node.begin() + g.node_first + g.node_count);
+    std::sort(euler_nodes.begin(), euler_nodes.end());
+    std::vector<uint32_t> want;
+    for (uint32_t j = 0; j < joints; ++j)
+      if (j != sets[k][0]) want.push_back(j);
+    CHECK(euler_nodes == want);
+    images.push_back(std::move(img));
+  }
+  CHECK(images[0]->rig_euler == images[1]->rig_euler);  // one set, one plan
+  CHECK(images[0]->rig_euler != images[2]->rig_euler);
+  CHECK(rig->plans.size() == internal::Rig::kMaxQuatPlans);
 }
 
 }  // TEST_SUITE

@@ -25,15 +25,12 @@ namespace {
 // An empty clip's image, with an empty rig that nothing allocates (an aliasing pointer with no
 // owner): the accessors below never throw.
 const Image& empty_image() {
-  static const internal::Rig kEmptyRig = [] {
-    internal::Rig r;
+  static const Image* const kEmpty = [] {  // made in place: neither an Image nor a Rig is copied
+    static internal::Rig r;
     r.hash = internal::rig_hash(r.skeleton);
-    return r;
-  }();
-  static const Image* const kEmpty = [] {  // made in place: an Image is not copied
     static Image i;
-    i.rig = std::shared_ptr<const internal::Rig>(std::shared_ptr<const internal::Rig>(), &kEmptyRig);
-    i.euler = &kEmptyRig.euler;
+    i.rig = std::shared_ptr<const internal::Rig>(std::shared_ptr<const internal::Rig>(), &r);
+    i.euler = &r.euler;
     return &i;
   }();
   return *kEmpty;

@@ -140,9 +140,11 @@ struct Image {
   uint32_t quat_lanes = 0;
   uint32_t quat_tracks = 0;
   // The Euler nodes' rotation groups (pose.cpp): the rig's when the clip has no quaternion
-  // node, else `own_euler`, made for the clip's Euler nodes when it attaches (plan_rotations).
+  // node, else those of the clip's Euler nodes (plan_rotations): `rig_euler`, kept by the rig
+  // for every clip of the same quaternion nodes, or `own_euler`.
   const EulerGroups* euler = nullptr;
   EulerGroups own_euler;
+  std::shared_ptr<const EulerGroups> rig_euler;  // or the rig's groups for the clip's set (Rig::plans)
   // Block tracks, one record per block each: quaternion track t < quat_tracks (curves t,
   // quat_tracks + t, 2 quat_tracks + t), then every other block curve alone.
   uint32_t block_tracks = 0;
@@ -170,7 +172,9 @@ struct Image {
 
 // IMAG's counts: its header's, and CLIP's channel count.
 ImageCounts image_counts(std::span<const uint8_t> imag, uint32_t channels) noexcept;
-// Sets img.euler (the rig and the quaternion nodes known): the rig's groups, or the clip's own.
+// Sets img.euler (the rig and the quaternion nodes known): the rig's groups, or those of the
+// clip's Euler nodes, made once per set of quaternion nodes and kept by the rig (Rig::plans;
+// the clips of a cached rig share them), else the clip's own.
 void plan_rotations(Image& img);
 // Points `img`'s arrays into `imag` (IMAG's content, 8-aligned), whose header and sizes are
 // known to be valid (built by build_image, or checked by the viewer): no check here.

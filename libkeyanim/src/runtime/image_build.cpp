@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <utility>
 
 #include "internal/quat_layout.h"
@@ -201,13 +202,29 @@ size_t Image::animation_bytes() const noexcept {
 }
 
 void plan_rotations(Image& img) {
+  const Rig& rig = *img.rig;
   if (img.quat_node.empty()) {
-    img.euler = &img.rig->euler;
+    img.euler = &rig.euler;
     return;
   }
-  std::vector<uint8_t> quat(img.rig->skeleton.joints.size(), 0);
-  for (uint32_t n : img.quat_node) quat[n] = 1;
-  img.own_euler = euler_groups(img.rig->skeleton, &quat);
+  std::vector<uint32_t> set(img.quat_node.begin(), img.quat_node.end());
+  std::sort(set.begin(), set.end());
+  const std::lock_guard<std::mutex> lock(rig.plans_mutex);
+  for (const Rig::QuatPlan& p : rig.plans) {
+    if (p.quat_nodes != set) continue;
+    img.rig_euler = p.euler;
+    img.euler = img.rig_euler.get();
+    return;
+  }
+  std::vector<uint8_t> quat(rig.skeleton.joints.size(), 0);
+  for (uint32_t n : set) quat[n] = 1;
+  if (rig.plans.size() < Rig::kMaxQuatPlans) {
+    img.rig_euler = std::make_shared<const EulerGroups>(euler_groups(rig.skeleton, &quat));
+    img.euler = img.rig_euler.get();
+    rig.plans.push_back({std::move(set), img.rig_euler});
+    return;
+  }
+  img.own_euler = euler_groups(rig.skeleton, &quat);
   img.euler = &img.own_euler;
 }
 

@@ -128,8 +128,14 @@ bool same_rig(const Skeleton& a, const Skeleton& b) noexcept {
 
 // The skeleton's nodes, the pose tables and the rig itself.
 size_t Rig::bytes() const noexcept {
+  size_t plan_bytes = 0;
+  {
+    const std::lock_guard<std::mutex> lock(plans_mutex);
+    for (const QuatPlan& p : plans) plan_bytes += p.quat_nodes.capacity() * sizeof(uint32_t) + sizeof(EulerGroups) + p.euler->bytes();
+    plan_bytes += plans.capacity() * sizeof(QuatPlan);
+  }
   return sizeof(Rig) + joints_bytes(skeleton) + node_offset.capacity() * sizeof(float) + euler.bytes() +
-         moves.capacity() * sizeof(Move);
+         moves.capacity() * sizeof(Move) + plan_bytes;
 }
 
 std::shared_ptr<const Rig> make_rig(Skeleton&& skeleton) {

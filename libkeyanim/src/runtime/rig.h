@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "internal/format.h"
@@ -43,6 +44,17 @@ struct Rig {
   std::vector<float> node_offset;
   EulerGroups euler;
   std::vector<Move> moves;
+
+  // The Euler groups of the nodes that a set of quaternion nodes (version 5) leaves, made once
+  // per set and shared by the rig's clips (a character's clips store the same joints as
+  // quaternions): plan_rotations. At most kMaxQuatPlans sets; a clip of another makes its own.
+  static constexpr size_t kMaxQuatPlans = 16;
+  struct QuatPlan {
+    std::vector<uint32_t> quat_nodes;  // increasing
+    std::shared_ptr<const EulerGroups> euler;
+  };
+  mutable std::mutex plans_mutex;
+  mutable std::vector<QuatPlan> plans;
 
   size_t bytes() const noexcept;  // everything the rig holds, itself included
 };

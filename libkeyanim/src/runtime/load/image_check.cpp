@@ -117,7 +117,10 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
                                  const ClipSource& parts, const Skeleton& skeleton) {
   const uint64_t blocks_of_clip = (uint64_t(parts.frame_count) + kBlockFrames - 1) / kBlockFrames;
   const uint64_t lanes = L::lanes(n.quat_nodes), T = n.quat_tracks;
-  std::vector<QuatNode> nodes(n.quat_nodes);
+  struct Listed {
+    uint32_t node, column;
+  };
+  std::vector<Listed> nodes(n.quat_nodes);
   for (uint64_t i = 0; i < lanes; ++i) {
     float ref[4];
     for (uint64_t k = 0; k < 4; ++k) ref[k] = at_index<float>(c, lay, L::quat_reference, k * lanes + i);
@@ -131,9 +134,10 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
     const uint64_t node_at = lay.at[L::quat_node] + 4 * i;
     // The tracks (nodes whose curves are block curves) first, then the others, each increasing.
     const bool ordered = i == 0 || i == T || node > nodes[i - 1].node;
-    if (node >= skeleton.joints.size() || !ordered || !quaternion_capable(skeleton.joints[node]))
+    uint32_t first = 0;
+    if (node >= skeleton.joints.size() || !ordered || !quaternion_capable(skeleton.joints[node], &first))
       return fail_in(Status::corrupt, c, node_at, "Quat_Node[" + std::to_string(i) + "] must be a node with three consecutive rotation channels about three axes, the tracks' first, each group increasing");
-    const uint32_t column = first_quat_channel(skeleton, node);
+    const uint32_t column = skeleton.joints[node].first_channel + first;
     if (at_index<uint32_t>(c, lay, L::quat_column, i) != column)
       return fail_in(Status::corrupt, c, lay.at[L::quat_column] + 4 * i, "Quat_Column[" + std::to_string(i) + "] is not its node's first rotation channel");
     const uint32_t keys = at_index<uint32_t>(c, lay, L::key_count, column);
@@ -142,25 +146,31 @@ Status Loader::check_image_quats(const Content& c, const ImageLayout& lay, const
     for (uint32_t k = 0; i < T && k < kTrackCurves; ++k)
       if (at_index<uint32_t>(c, lay, L::curve_channel, i + k * T) != column + k)
         return fail_in(Status::corrupt, c, lay.at[L::curve_channel] + 4 * (i + k * T), "quaternion track " + std::to_string(i) + "'s curves must be t, T + t, 2T + t");
-    nodes[i].node = node;
-    if (!reference_from_floats(ref, nodes[i]))
+    nodes[i] = {node, column};
+    QuatNode q;
+    if (!reference_from_floats(ref, q))
       return fail_in(Status::corrupt, c, ref_at, "Quat_Reference " + std::to_string(i) + " is not a reference's binary32 quaternion (section 9.2)");
   }
-  std::vector<uint8_t> listed(skeleton.joints.size(), 0);  // no node twice (the two groups are each increasing)
-  for (uint64_t i = 0; i < n.quat_nodes; ++i) {
-    if (listed[nodes[i].node]++)
-      return fail_in(Status::corrupt, c, lay.at[L::quat_node] + 4 * i, "Quat_Node lists node " + std::to_string(nodes[i].node) + " twice");
-  }
-  std::sort(nodes.begin(), nodes.end(), [](const QuatNode& a, const QuatNode& b) { return a.node < b.node; });
-  const std::vector<Stored> kinds = stored_kinds(skeleton, nodes);
-  for (uint64_t ch = 0; ch < n.channels; ++ch) {
-    if (kinds[ch] != Stored::quat_y && kinds[ch] != Stored::quat_z) continue;
-    const uint64_t x = ch - (kinds[ch] == Stored::quat_y ? 1 : 2);
-    if (c.data[lay.at[L::interpolation] + ch] != c.data[lay.at[L::interpolation] + x] ||
-        at_index<uint32_t>(c, lay, L::tension, ch) != at_index<uint32_t>(c, lay, L::tension, x) ||
-        at_index<uint32_t>(c, lay, L::key_count, ch) != at_index<uint32_t>(c, lay, L::key_count, x))
-      return fail_in(Status::corrupt, c, lay.at[L::key_count] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
-    if (Status s = check_shared_frames(c, lay, n, ch, x); s != Status::ok) return s;
+  // No node twice. Sorted by node (then place), a repeat follows its node's first entry; the
+  // one reported is the first entry of Quat_Node that repeats an earlier one.
+  std::vector<uint32_t> order(n.quat_nodes);
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return nodes[a].node < nodes[b].node || (nodes[a].node == nodes[b].node && a < b); });
+  uint64_t repeat = n.quat_nodes;
+  for (size_t j = 1; j < order.size(); ++j)
+    if (nodes[order[j]].node == nodes[order[j - 1]].node) repeat = std::min<uint64_t>(repeat, order[j]);
+  if (repeat < n.quat_nodes)
+    return fail_in(Status::corrupt, c, lay.at[L::quat_node] + 4 * repeat, "Quat_Node lists node " + std::to_string(nodes[repeat].node) + " twice");
+  // Each node's y and z (channels column + 1, + 2) against its x, in channel order.
+  for (const uint32_t i : order) {
+    const uint64_t x = nodes[i].column;
+    for (uint64_t ch = x + 1; ch <= x + 2; ++ch) {
+      if (c.data[lay.at[L::interpolation] + ch] != c.data[lay.at[L::interpolation] + x] ||
+          at_index<uint32_t>(c, lay, L::tension, ch) != at_index<uint32_t>(c, lay, L::tension, x) ||
+          at_index<uint32_t>(c, lay, L::key_count, ch) != at_index<uint32_t>(c, lay, L::key_count, x))
+        return fail_in(Status::corrupt, c, lay.at[L::key_count] + 4 * ch, "channel " + std::to_string(ch) + ": a quaternion node's y and z must have its x's Interpolation, Tension and Key_Count");
+      if (Status s = check_shared_frames(c, lay, n, ch, x); s != Status::ok) return s;
+    }
   }
   return Status::ok;
 }
